@@ -1,0 +1,65 @@
+// Camera -> the constants a Unity shader sees (DESIGN.md §1, §2): _ZBufferParams,
+// _ProjectionParams and the four far-plane frustum-corner rays.
+#pragma once
+
+#include <array>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+namespace fogcl {
+
+// A symmetric perspective camera. View space: camera at the origin looking along +z, +y up
+// (Unity's camera space for CalculateFrustumCorners).
+struct PerspectiveCamera {
+  float fov_y_deg = 60.0f;         // vertical field of view [degrees], in (0, 180); Unity default 60
+  float aspect = 16.0f / 9.0f;     // width / height, finite and > 0
+  float near_plane = 0.3f;         // [world units], finite and > 0; Unity default 0.3
+  float far_plane = 1000.0f;       // [world units], finite and > near_plane; Unity default 1000
+  bool reversed_z = false;         // depth 1 at near, 0 at far (D3D11+/Metal/Vulkan Unity)
+};
+
+// Corner order used by fogcl: bottom-left, bottom-right, top-left, top-right (index u + 2v).
+enum Corner { kBottomLeft = 0, kBottomRight = 1, kTopLeft = 2, kTopRight = 3 };
+
+struct CameraParams {
+  // _ZBufferParams. Conventional Z: (1 - f/n, f/n, x/f, y/f); reversed Z: (-1 + f/n, 1, x/f, 1/f).
+  glm::vec4 zbuffer_params{0.0f};
+  // _ProjectionParams: (1, near, far, 1/far). x = -1 would mean a flipped projection (unused).
+  glm::vec4 projection_params{0.0f};
+  // Far-plane corner rays in view space (z = far), in Corner order.
+  std::array<glm::vec3, 4> frustum_corners{};
+  bool reversed_z = false;
+
+  float near_plane() const { return projection_params.y; }
+  float far_plane() const { return projection_params.z; }
+};
+
+// Throws fogcl::Error naming the value and the rule for an invalid camera.
+void validate(const PerspectiveCamera& camera);
+
+// The constants exactly as Unity computes them (float arithmetic for _ZBufferParams).
+CameraParams make_camera_params(const PerspectiveCamera& camera);
+
+// How a projection matrix maps view depth to clip-space z: OpenGL / GLM default (-1..1) or
+// D3D / Vulkan / GLM_FORCE_DEPTH_ZERO_TO_ONE (0..1). The depth buffer holds [0, 1] either way.
+enum class ClipDepth { negative_one_to_one, zero_to_one };
+
+// Recovers the camera from a GLM (column-major) projection matrix, right- or left-handed,
+// conventional or reversed Z. Throws fogcl::Error for orthographic, asymmetric (off-centre),
+// y-flipped or infinite-far projections, which have no PerspectiveCamera.
+PerspectiveCamera camera_from_projection(const glm::mat4& projection,
+                                         ClipDepth clip_depth = ClipDepth::negative_one_to_one);
+
+// Unity's Camera.CalculateFrustumCorners returns bottom-left, top-left, top-right, bottom-right;
+// this returns them in fogcl's Corner order.
+std::array<glm::vec3, 4> corners_from_unity_order(const std::array<glm::vec3, 4>& unity_corners);
+
+}  // namespace fogcl
+
+namespace fogcl {
+// Checks constants handed in directly (integration API): finite, near > 0, far > near, and
+// _ZBufferParams consistent with a perspective depth (x * 1 + y > 0). Throws fogcl::Error.
+void validate(const CameraParams& params);
+}  // namespace fogcl

@@ -1,0 +1,50 @@
+// The built-in test scene of Catlike Coding's "Rendering 14: Fog": a few gray-white spheres on a
+// ground plane under a sky, ray cast analytically so color and depth are exact for the camera.
+//
+// World (Unity's: left-handed, +x right, +y up, +z forward), in world units:
+// - ground: the plane y = 0, infinite, albedo 0.80 with a faint 2-unit checker (0.80 / 0.72) that
+//   fades to its mean where a square would cover less than two 1-mrad pixels (a
+//   function of the ray only: the color of a ray does not depend on the resolution);
+// - 7 spheres, albedo ~0.8, centre (radius): (-0.9, 0.5, -3.5) (0.5), (2.2, 1, -0.5) (1),
+//   (-3.8, 1.5, 7) (1.5), (-12, 2, 16) (2), (-3, 3, 27) (3), (5, 4, 42) (4), (34, 5, 56) (5):
+//   each rests on the ground, about 2.9 to 71 units from the default eye;
+// - light: one directional light from normalize(0.35, 0.8, -0.5) (behind the default camera,
+//   to its right and above), color (1, 0.96, 0.9), Lambert, hard shadows cast by the spheres;
+//   ambient (0.22, 0.25, 0.3);
+// - sky: a vertical gradient from (0.85, 0.93, 1.1) at the horizon to (0.3, 0.5, 0.9) at the
+//   zenith; it is also what pixels show where the ground lies beyond the far plane.
+// One ray per pixel centre, in double, no anti-aliasing: pixel (x, y) takes the ray of DESIGN.md
+// §2 (u = (x + 0.5) / W, v = 1 - (y + 0.5) / H, bilinear in the frustum corners) rotated into the
+// world by the DemoView basis; its depth is the raw device depth of the hit for the camera
+// (Linear01Depth(raw) = z_eye / far with the float _ZBufferParams), sky depth 1 (conventional Z)
+// or 0 (reversed Z).
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include "fogcl/camera.h"
+#include "fogcl/image.h"
+
+namespace fogcl {
+
+struct DemoFrame {
+  ColorImage color;   // linear RGB, alpha 1 everywhere
+  DepthImage depth;   // raw device depth for the camera (sky: 1 conventional, 0 reversed Z)
+  PerspectiveCamera camera;
+  CameraParams params;  // make_camera_params(camera)
+};
+
+// Camera placement in the world: eye at `eye`, looking at `target`, +y up (view +x is image right;
+// looking along +z, image right is world +x). Throws fogcl::Error if target == eye, the eye is inside a sphere or the view
+// direction is parallel to +y.
+struct DemoView {
+  glm::vec3 eye{0.0f, 1.6f, -6.0f};    // [world units]
+  glm::vec3 target{0.0f, 0.6f, 10.0f};
+};
+
+// Renders width x height pixels (>= 1 each, else fogcl::Error). camera.aspect is ignored and set to
+// float(width) / float(height); the camera is validated as make_camera_params does.
+DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera = {},
+                            const DemoView& view = {}, ColorFormat format = ColorFormat::rgba32f);
+
+}  // namespace fogcl

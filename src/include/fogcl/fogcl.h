@@ -1,0 +1,11 @@
+// Umbrella header of the fogcl library.
+#pragma once
+
+#include "fogcl/camera.h"
+#include "fogcl/error.h"
+#include "fogcl/fog_pass.h"
+#include "fogcl/fog_settings.h"
+#include "fogcl/image.h"
+#include "fogcl/runtime.h"
+#include "fogcl/scalar.h"
+#include "fogcl/variant.h"

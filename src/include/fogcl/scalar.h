@@ -1,0 +1,39 @@
+// The scalar C++ path: one thread, the formulas of kernels/fog_math.h instantiated on the float
+// type. float is the benchmark baseline and the no-OpenCL fallback; double is the reference every
+// other path's error is measured against (DESIGN.md §4).
+#pragma once
+
+#include <vector>
+
+#include "fogcl/camera.h"
+#include "fogcl/fog_settings.h"
+#include "fogcl/image.h"
+
+namespace fogcl {
+
+// Fogs `in` into `out` in float, the same storage format as `in` (out is reallocated unless it
+// already has in's size and format; out may be in). Same rules as the OpenCL pass: fog off or
+// density 0 copies the input bit for bit; f == 1 pixels keep their bits; alpha passes through.
+// Throws fogcl::Error for invalid settings, camera constants or mismatched/empty images.
+void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                      const CameraParams& camera, const FogSettings& settings);
+
+// The fog evaluated in T (float or double), unrounded to the storage format: rgba has
+// 4 * width * height values, factor (if asked) width * height fog factors f.
+template <class T>
+struct FogResult {
+  int width = 0, height = 0;
+  std::vector<T> rgba;
+  std::vector<T> factor;
+};
+
+template <class T>
+FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& camera,
+                        const FogSettings& settings);
+
+extern template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&,
+                                                   const CameraParams&, const FogSettings&);
+extern template FogResult<double> fog_scalar<double>(const ColorImage&, const DepthImage&,
+                                                     const CameraParams&, const FogSettings&);
+
+}  // namespace fogcl

@@ -1,0 +1,50 @@
+// The kernel variant a scene needs (DESIGN.md §3): every feature is a -D switch, and a feature
+// the scene does not use is not compiled at all. select_variant() and build_options() are the one
+// place where settings and camera become build options.
+#pragma once
+
+#include <string>
+
+#include "fogcl/camera.h"
+#include "fogcl/fog_settings.h"
+#include "fogcl/image.h"
+
+namespace fogcl {
+
+enum class KernelMode {
+  none,         // no pass: fog off, or exp/exp2 with density 0 (f == 1 everywhere)
+  linear,       // FOG_MODE=1
+  linear_step,  // FOG_MODE=2: linear with start == end
+  exp,          // FOG_MODE=3
+  exp2,         // FOG_MODE=4
+};
+
+struct Variant {
+  KernelMode mode = KernelMode::none;
+  bool distance = false;    // FOG_DISTANCE
+  bool fog_skybox = false;  // FOG_SKYBOX (no sky test)
+  bool reversed_z = false;  // REVERSED_Z
+  ColorFormat storage = ColorFormat::rgba32f;  // FOG_COLOR_HALF
+  Precision precision = Precision::precise;    // FOG_NATIVE_MATH + -cl-fast-relaxed-math
+
+  bool needs_pass() const { return mode != KernelMode::none; }
+  bool operator==(const Variant& o) const {
+    return mode == o.mode && distance == o.distance && fog_skybox == o.fog_skybox &&
+           reversed_z == o.reversed_z && storage == o.storage && precision == o.precision;
+  }
+};
+
+// Validates the settings and derives the variant. Throws fogcl::Error on invalid settings.
+Variant select_variant(const FogSettings& settings, const CameraParams& camera, ColorFormat storage);
+
+// "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE ..." for a device whose CL_DEVICE_OPENCL_C_VERSION
+// is `device_c_version` ("OpenCL C 1.2 ..."). Deterministic: equal variants give equal strings,
+// so the string is the program cache key.
+std::string build_options(const Variant& variant, const std::string& device_c_version = "OpenCL C 1.2");
+
+// Human-readable, e.g. "exp2 depth sky-test conventional-z rgba32f precise".
+std::string describe(const Variant& variant);
+
+const char* to_string(KernelMode mode);
+
+}  // namespace fogcl

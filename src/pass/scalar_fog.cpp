@@ -1,0 +1,149 @@
+#include "fogcl/scalar.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <Imath/half.h>
+
+#include "fogcl/variant.h"
+#include "settings/fog_coefficients.h"
+
+namespace fogcl {
+namespace detail {
+using std::exp2;
+using std::fma;
+using std::fmax;
+using std::fmin;
+using std::sqrt;
+#include "fog_math.h"
+}  // namespace detail
+
+namespace {
+
+float load_channel(const float* p) { return *p; }
+float load_channel(const std::uint16_t* p) {
+  Imath::half h;
+  h.setBits(*p);
+  return float(h);
+}
+
+// The pixel loop shared by every scalar instantiation. Calls sink(i, f, rgba) per pixel with the
+// fog factor and the blended color (alpha passed through), both in T.
+template <class T, class Channel, class Sink>
+void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParams& cam,
+                const Variant& v, const FogSettings& s, Sink&& sink) {
+  using namespace detail;
+  const int w = depth.width(), h = depth.height();
+  const FogCoefficients<T> k = fog_coefficients<T>(s, v.mode);
+  const T zx = T(cam.zbuffer_params.x), zy = T(cam.zbuffer_params.y);
+  const T near_plane = T(cam.near_plane()), far_plane = T(cam.far_plane());
+  const T fog[3] = {T(s.color.r), T(s.color.g), T(s.color.b)};
+  const auto& cn = cam.frustum_corners;
+  const float* raw_depth = depth.data();
+  for (int y = 0; y < h; ++y) {
+    const T vv = fog_pixel_v<T>(y, h);
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+      const T linear01 = fog_linear01_depth(fog_sanitize_depth(T(raw_depth[i]), int(v.reversed_z)), zx, zy);
+      T f = 1;
+      if (v.fog_skybox || !fog_is_sky(linear01)) {
+        T d;
+        if (v.distance) {
+          const T u = fog_pixel_u<T>(x, w);
+          T ray[3];
+          for (int c = 0; c < 3; ++c)
+            ray[c] = fog_bilerp(T(cn[kBottomLeft][c]), T(cn[kBottomRight][c]), T(cn[kTopLeft][c]),
+                                T(cn[kTopRight][c]), u, vv);
+          d = fog_radial_distance(linear01, ray[0], ray[1], ray[2]);
+        } else {
+          d = fog_depth_distance(linear01, near_plane, far_plane);
+        }
+        switch (v.mode) {
+          case KernelMode::linear: f = fog_factor_linear(d, k.a, k.b); break;
+          case KernelMode::linear_step: f = fog_factor_step(d, k.a); break;
+          case KernelMode::exp: f = fog_factor_exp(d, k.a); break;
+          case KernelMode::exp2: f = fog_factor_exp2(d, k.a); break;
+          case KernelMode::none: break;
+        }
+      }
+      const Channel* c = color + 4 * i;
+      T rgba[4];
+      for (int ch = 0; ch < 3; ++ch) rgba[ch] = fog_blend(T(load_channel(c + ch)), fog[ch], f);
+      rgba[3] = T(load_channel(c + 3));
+      sink(i, f, rgba);
+    }
+  }
+}
+
+// Runs fog_pixels with the channel type of the image's storage.
+template <class T, class Sink>
+void fog_image(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+               const Variant& v, const FogSettings& s, Sink&& sink) {
+  if (in.format() == ColorFormat::rgba32f)
+    fog_pixels<T>(in.rgba32f(), depth, cam, v, s, sink);
+  else
+    fog_pixels<T>(in.rgba16f(), depth, cam, v, s, sink);
+}
+
+Variant checked_variant(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+                        const FogSettings& s) {
+  validate_frame(in, depth);
+  validate(cam);
+  return select_variant(s, cam, in.format());
+}
+
+}  // namespace
+
+void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                      const CameraParams& cam, const FogSettings& s) {
+  const Variant v = checked_variant(in, depth, cam, s);
+  if (&out != &in && (out.width() != in.width() || out.height() != in.height() ||
+                      out.format() != in.format()))
+    out = ColorImage(in.width(), in.height(), in.format());
+  if (!v.needs_pass()) {
+    if (&out != &in) std::memcpy(out.data(), in.data(), in.size_bytes());
+    return;
+  }
+  const std::size_t pixel_bytes = bytes_per_pixel(in.format());
+  const auto* src = static_cast<const std::byte*>(in.data());
+  auto* dst = static_cast<std::byte*>(out.data());
+  if (in.format() == ColorFormat::rgba32f) {
+    float* o = out.rgba32f();
+    fog_image<float>(in, depth, cam, v, s, [&](std::size_t i, float, const float* rgba) {
+      for (int c = 0; c < 4; ++c) o[4 * i + c] = rgba[c];
+    });
+  } else {
+    std::uint16_t* o = out.rgba16f();
+    fog_image<float>(in, depth, cam, v, s, [&](std::size_t i, float f, const float* rgba) {
+      if (f == 1.0f) {  // keep the bits: a half -> float -> half trip would quiet a signalling NaN
+        std::memcpy(dst + i * pixel_bytes, src + i * pixel_bytes, pixel_bytes);
+        return;
+      }
+      for (int c = 0; c < 3; ++c) o[4 * i + c] = Imath::half(rgba[c]).bits();
+      o[4 * i + 3] = in.rgba16f()[4 * i + 3];
+    });
+  }
+}
+
+template <class T>
+FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+                        const FogSettings& s) {
+  const Variant v = checked_variant(in, depth, cam, s);
+  FogResult<T> r;
+  r.width = in.width();
+  r.height = in.height();
+  r.rgba.resize(4 * in.pixel_count());
+  r.factor.resize(in.pixel_count());
+  fog_image<T>(in, depth, cam, v, s, [&](std::size_t i, T f, const T* rgba) {
+    r.factor[i] = f;
+    for (int c = 0; c < 4; ++c) r.rgba[4 * i + c] = rgba[c];
+  });
+  return r;
+}
+
+template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,
+                                            const FogSettings&);
+template FogResult<double> fog_scalar<double>(const ColorImage&, const DepthImage&,
+                                              const CameraParams&, const FogSettings&);
+
+}  // namespace fogcl

@@ -1,0 +1,220 @@
+// The built-in test scene (Catlike Coding "Rendering 14: Fog"): gray-white spheres on an infinite
+// ground plane under a sky gradient, ray cast analytically in double, one ray per pixel centre
+// (no anti-aliasing: the depth of a pixel is the depth of the surface its colour comes from).
+#include "fogcl/demo_scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "fogcl/error.h"
+
+namespace fogcl {
+
+namespace {
+
+struct V3 {
+  double x = 0, y = 0, z = 0;
+};
+V3 operator+(V3 a, V3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V3 operator-(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 operator*(V3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+double dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 cross(V3 a, V3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double length(V3 a) { return std::sqrt(dot(a, a)); }
+V3 normalize(V3 a) { return a * (1.0 / length(a)); }
+V3 to_v3(const glm::vec3& v) { return {double(v.x), double(v.y), double(v.z)}; }
+
+struct Sphere {
+  V3 centre;
+  double radius;
+  double albedo;
+};
+
+// The scene, in world units (Unity's world: left-handed, +x right, +y up, +z forward). Every
+// sphere rests on the ground; distances of the centres from the default eye (0, 1.6, -6): about
+// 2.9, 6.0, 13.5, 25, 33, 48 and 71.
+constexpr int kSphereCount = 7;
+const std::array<Sphere, kSphereCount> kSpheres{{
+    {{-0.9, 0.5, -3.5}, 0.5, 0.80},
+    {{2.2, 1.0, -0.5}, 1.0, 0.82},
+    {{-3.8, 1.5, 7.0}, 1.5, 0.78},
+    {{-12.0, 2.0, 16.0}, 2.0, 0.80},
+    {{-3.0, 3.0, 27.0}, 3.0, 0.82},
+    {{5.0, 4.0, 42.0}, 4.0, 0.78},
+    {{34.0, 5.0, 56.0}, 5.0, 0.80},
+}};
+
+constexpr double kGroundAlbedo = 0.80;      // checker squares: 0.80 and 0.80 - kCheckerContrast
+constexpr double kCheckerContrast = 0.08;
+constexpr double kCheckerSize = 2.0;        // [world units]
+constexpr double kFadeAngle = 1e-3;         // [rad]
+const V3 kSunColor{1.00, 0.96, 0.90};
+const V3 kAmbient{0.22, 0.25, 0.30};
+const V3 kSkyHorizon{0.85, 0.93, 1.10};
+const V3 kSkyZenith{0.30, 0.50, 0.90};
+
+// First hit of the ray o + t d (t > t_min) with a sphere; returns +inf when there is none.
+double hit_sphere(const Sphere& s, V3 o, V3 d, double t_min) {
+  const V3 oc = o - s.centre;
+  const double a = dot(d, d);
+  const double b = dot(oc, d);
+  const double c = dot(oc, oc) - s.radius * s.radius;
+  const double disc = b * b - a * c;
+  if (disc < 0.0) return std::numeric_limits<double>::infinity();
+  const double sq = std::sqrt(disc);
+  // Stable roots: q = -(b + sign(b) sq); t0 = q / a, t1 = c / q.
+  const double q = b > 0.0 ? -(b + sq) : -(b - sq);
+  double t0 = q / a, t1 = q != 0.0 ? c / q : t0;
+  if (t0 > t1) std::swap(t0, t1);
+  if (t0 > t_min) return t0;
+  if (t1 > t_min) return t1;
+  return std::numeric_limits<double>::infinity();
+}
+
+bool in_shadow(V3 p, V3 to_light) {
+  for (const Sphere& s : kSpheres)
+    if (std::isfinite(hit_sphere(s, p, to_light, 1e-6))) return true;
+  return false;
+}
+
+V3 sky(V3 dir_unit) {
+  const double s = std::sqrt(std::clamp(dir_unit.y, 0.0, 1.0));
+  return kSkyHorizon * (1.0 - s) + kSkyZenith * s;
+}
+
+}  // namespace
+
+DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera,
+                            const DemoView& view, ColorFormat format) {
+  if (width < 1 || height < 1)
+    throw Error("demo scene size must be at least 1x1 (got " + std::to_string(width) + "x" +
+                std::to_string(height) + ")");
+  camera.aspect = float(width) / float(height);
+  DemoFrame frame;
+  frame.params = make_camera_params(camera);  // validates the camera
+  frame.camera = camera;
+  frame.color = ColorImage(width, height, format);
+
+  const CameraParams& p = frame.params;
+  const double far = double(p.far_plane());
+  const double near = double(p.near_plane());
+  const double zb_x = double(p.zbuffer_params.x), zb_y = double(p.zbuffer_params.y);
+  const float sky_raw = p.reversed_z ? 0.0f : 1.0f;
+  const float near_raw = p.reversed_z ? 1.0f : 0.0f;
+  frame.depth = DepthImage(width, height, sky_raw);
+
+  // Camera basis (left-handed like Unity's view space): view +z = forward, +x = right, +y = up.
+  const V3 eye = to_v3(view.eye);
+  const V3 to_target = to_v3(view.target) - eye;
+  if (!(length(to_target) > 0.0) || !std::isfinite(length(to_target)))
+    throw Error("demo view target must differ from the eye and be finite");
+  const V3 forward = normalize(to_target);
+  const V3 world_up{0.0, 1.0, 0.0};
+  const V3 right_raw = cross(world_up, forward);
+  if (!(length(right_raw) > 1e-9))
+    throw Error("demo view must not look straight up or down (forward is parallel to +y)");
+  const V3 right = normalize(right_raw);
+  const V3 up = cross(forward, right);
+
+  std::array<V3, 4> corner;
+  for (int i = 0; i < 4; ++i) corner[i] = to_v3(p.frustum_corners[i]) * (1.0 / far);
+
+  // Per-sphere terms of the primary rays, which all start at the eye.
+  std::array<V3, kSphereCount> eye_to_centre;
+  std::array<double, kSphereCount> eye_c;
+  bool eye_outside = true;
+  for (int i = 0; i < kSphereCount; ++i) {
+    eye_to_centre[i] = kSpheres[i].centre - eye;
+    eye_c[i] = dot(eye_to_centre[i], eye_to_centre[i]) - kSpheres[i].radius * kSpheres[i].radius;
+    eye_outside = eye_outside && eye_c[i] > 0.0;
+  }
+  if (!eye_outside) throw Error("demo view eye must lie outside the scene's spheres");
+
+  const V3 to_light = normalize(V3{0.35, 0.80, -0.50});
+
+  float* const rgba32 = format == ColorFormat::rgba32f ? frame.color.rgba32f() : nullptr;
+  for (int y = 0; y < height; ++y) {
+    const double v = 1.0 - (double(y) + 0.5) / double(height);
+    for (int x = 0; x < width; ++x) {
+      const double u = (double(x) + 0.5) / double(width);
+      // Bilinear interpolation of the corners (index u + 2v); view z is exactly 1.
+      const V3 bottom = corner[kBottomLeft] * (1.0 - u) + corner[kBottomRight] * u;
+      const V3 top = corner[kTopLeft] * (1.0 - u) + corner[kTopRight] * u;
+      const V3 ray_view = bottom * (1.0 - v) + top * v;
+      const V3 dir = right * ray_view.x + up * ray_view.y + forward * ray_view.z;
+      const V3 dir_unit = normalize(dir);
+
+      // Nearest hit; t is the view depth z_eye because the ray's view z is 1.
+      double t = std::numeric_limits<double>::infinity();
+      int hit = -1;  // -1: none, 0..: sphere, kSphereCount: ground
+      const double a = dot(dir, dir);
+      for (int i = 0; i < kSphereCount; ++i) {
+        // Nearest root of a t^2 + 2 b t + c (the eye is outside every sphere: c > 0).
+        const double b = dot(eye_to_centre[i], dir) * -1.0;
+        if (b >= 0.0) continue;  // the sphere is behind the eye
+        const double disc = b * b - a * eye_c[i];
+        if (disc < 0.0) continue;
+        const double ti = eye_c[i] / (-b + std::sqrt(disc));  // stable form of (-b - sqrt) / a
+        if (ti < t) t = ti, hit = i;
+      }
+      if (dir.y < 0.0 && eye.y > 0.0) {
+        const double tg = -eye.y / dir.y;
+        if (tg < t) t = tg, hit = kSphereCount;
+      }
+
+      V3 rgb;
+      if (hit < 0 || !(t <= far)) {
+        // Sky, and everything beyond the far plane: keeps the sky depth.
+        rgb = sky(dir_unit);
+      } else {
+        const V3 pos = eye + dir * t;
+        V3 normal;
+        double albedo;
+        if (hit == kSphereCount) {
+          normal = {0.0, 1.0, 0.0};
+          const long cx = long(std::floor(pos.x / kCheckerSize));
+          const long cz = long(std::floor(pos.z / kCheckerSize));
+          // Ground footprint of a 1 mrad pixel (about 1080p at 60 degrees; grows at grazing
+          // angles); the checker fades out before a square is smaller than two such pixels. A
+          // fixed angle keeps the color a function of the ray alone, whatever the resolution.
+          const double footprint = t * length(dir) * kFadeAngle / std::max(-dir_unit.y, 1e-6);
+          const double fade = std::clamp(1.0 - footprint / kCheckerSize * 2.0, 0.0, 1.0);
+          albedo = kGroundAlbedo - (((cx + cz) & 1) != 0 ? kCheckerContrast * fade : 0.0) -
+                   kCheckerContrast * 0.5 * (1.0 - fade);
+        } else {
+          normal = normalize(pos - kSpheres[hit].centre);
+          albedo = kSpheres[hit].albedo;
+        }
+        const double n_dot_l = dot(normal, to_light);
+        V3 light = kAmbient;
+        if (n_dot_l > 0.0 && !in_shadow(pos + normal * 1e-7, to_light))
+          light = light + kSunColor * n_dot_l;
+        rgb = light * albedo;
+
+        double raw;
+        if (t < near) {
+          raw = near_raw;
+        } else {
+          // Inverse of Linear01Depth with the float _ZBufferParams: 1/(x raw + y) = t / far.
+          raw = std::clamp((far / t - zb_y) / zb_x, 0.0, 1.0);
+        }
+        frame.depth.at(x, y) = float(raw);
+      }
+      if (rgba32 != nullptr) {
+        float* px = rgba32 + 4 * (std::size_t(y) * std::size_t(width) + std::size_t(x));
+        px[0] = float(rgb.x), px[1] = float(rgb.y), px[2] = float(rgb.z), px[3] = 1.0f;
+      } else {
+        frame.color.set_pixel(x, y, glm::vec4(float(rgb.x), float(rgb.y), float(rgb.z), 1.0f));
+      }
+    }
+  }
+  return frame;
+}
+
+}  // namespace fogcl

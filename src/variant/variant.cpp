@@ -1,0 +1,74 @@
+#include "fogcl/variant.h"
+
+#include <cstdio>
+
+#include "fogcl/error.h"
+
+namespace fogcl {
+
+Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFormat storage) {
+  validate(s);
+  Variant v;
+  switch (s.mode) {
+    case FogMode::off:
+      return v;
+    case FogMode::linear:
+      v.mode = s.start == s.end ? KernelMode::linear_step : KernelMode::linear;
+      break;
+    case FogMode::exp:
+    case FogMode::exp2:
+      // density 0 gives f = 1 for every finite distance: no pass, output = input bit for bit.
+      if (s.density == 0.0f) return v;
+      v.mode = s.mode == FogMode::exp ? KernelMode::exp : KernelMode::exp2;
+      break;
+  }
+  v.distance = s.metric == FogMetric::distance;
+  v.fog_skybox = s.fog_skybox;
+  v.reversed_z = camera.reversed_z;
+  v.storage = storage;
+  v.precision = s.precision;
+  return v;
+}
+
+std::string build_options(const Variant& v, const std::string& device_c_version) {
+  if (!v.needs_pass()) throw Error("build_options: the variant needs no kernel (fog is off)");
+  int major = 0, minor = 0;
+  if (std::sscanf(device_c_version.c_str(), "OpenCL C %d.%d", &major, &minor) != 2)
+    throw Error("device reports an unreadable OpenCL C version '" + device_c_version + "'");
+  if (major * 10 + minor < 11)
+    throw Error("device OpenCL C version " + device_c_version + " is older than 1.1");
+  // The kernel uses nothing past OpenCL C 1.2; ask for the newest of 1.1 / 1.2 the device has.
+  std::string o = major * 10 + minor >= 12 ? "-cl-std=CL1.2" : "-cl-std=CL1.1";
+  o += " -D FOG_MODE=" + std::to_string(int(v.mode));
+  if (v.distance) o += " -D FOG_DISTANCE";
+  if (v.fog_skybox) o += " -D FOG_SKYBOX";
+  if (v.reversed_z) o += " -D REVERSED_Z";
+  if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
+  if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
+  return o;
+}
+
+const char* to_string(KernelMode m) {
+  switch (m) {
+    case KernelMode::none: return "none";
+    case KernelMode::linear: return "linear";
+    case KernelMode::linear_step: return "linear-step";
+    case KernelMode::exp: return "exp";
+    case KernelMode::exp2: return "exp2";
+  }
+  return "?";
+}
+
+std::string describe(const Variant& v) {
+  if (!v.needs_pass()) return "none (no pass)";
+  std::string d = to_string(v.mode);
+  d += v.distance ? " distance" : " depth";
+  d += v.fog_skybox ? " fog-skybox" : " sky-test";
+  d += v.reversed_z ? " reversed-z " : " conventional-z ";
+  d += to_string(v.storage);
+  d += ' ';
+  d += to_string(v.precision);
+  return d;
+}
+
+}  // namespace fogcl

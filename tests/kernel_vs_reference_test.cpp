@@ -1,0 +1,117 @@
+// Kernel vs scalar<float> vs scalar<double> for every variant (mode x depth/distance x skybox x
+// Z convention x f32/f16 storage) on 1x1, 7x5, 333x211 and 1920x1080. Budgets against the double
+// path: 2e-6 absolute on the fog factor, 1e-5 relative on color (f32), 1 half ulp (f16).
+#include <cstdio>
+#include <map>
+#include <tuple>
+
+#include "test_support.h"
+
+namespace fogcl::test {
+namespace {
+
+constexpr double kFactorBudget = 2e-6;
+constexpr double kColorRelBudget = 1e-5;
+constexpr double kHalfUlpBudget = 1.0;
+constexpr float kStepStart = 40.0f;
+
+FogSettings settings_for(KernelMode mode, bool distance, bool skybox) {
+  FogSettings s;
+  s.color = glm::vec3(0.5f, 0.6f, 0.7f);
+  s.metric = distance ? FogMetric::distance : FogMetric::depth;
+  s.fog_skybox = skybox;
+  switch (mode) {
+    case KernelMode::linear: s.mode = FogMode::linear; s.start = 10; s.end = 400; break;
+    case KernelMode::linear_step: s.mode = FogMode::linear; s.start = s.end = kStepStart; break;
+    case KernelMode::exp: s.mode = FogMode::exp; s.density = 0.01f; break;
+    case KernelMode::exp2: s.mode = FogMode::exp2; s.density = 0.005f; break;
+    case KernelMode::none: s.mode = FogMode::off; break;
+  }
+  return s;
+}
+
+// Frames are costly at 1080p: make each (size, Z, format) once.
+const TestFrame& frame(int w, int h, bool reversed, ColorFormat format) {
+  static std::map<std::tuple<int, int, bool, ColorFormat>, TestFrame> cache;
+  auto key = std::make_tuple(w, h, reversed, format);
+  auto it = cache.find(key);
+  if (it == cache.end()) it = cache.emplace(key, make_test_frame(w, h, reversed, format, 1, kStepStart)).first;
+  return it->second;
+}
+
+using Param = std::tuple<KernelMode, bool /*distance*/, bool /*skybox*/, bool /*reversed*/,
+                         ColorFormat, std::pair<int, int>>;
+
+class KernelVsReference : public ::testing::TestWithParam<Param> {};
+
+TEST_P(KernelVsReference, WithinBudget) {
+  FOGCL_REQUIRE_DEVICE();
+  const auto [mode, distance, skybox, reversed, format, size] = GetParam();
+  const TestFrame& t = frame(size.first, size.second, reversed, format);
+  const FogSettings s = settings_for(mode, distance, skybox);
+
+  FogPass& pass = shared_pass();
+  ColorImage kernel_out, scalar_out;
+  pass.apply(t.color, t.depth, kernel_out, t.params, s);
+  ASSERT_EQ(pass.last_variant().mode, mode);
+  apply_fog_scalar(t.color, t.depth, scalar_out, t.params, s);
+  const FogResult<double> ref = fog_scalar<double>(t.color, t.depth, t.params, s);
+
+  const ErrorStats k = compare_color(kernel_out, ref, t.color, s.color);
+  const ErrorStats c = compare_color(scalar_out, ref, t.color, s.color);
+
+  // Fog factor, through a probe run that makes each channel equal to f (f32 storage only; half
+  // storage would round f itself).
+  double kf = 0, cf = 0;
+  if (format == ColorFormat::rgba32f) {
+    FogSettings probe = s;
+    probe.color = glm::vec3(0.0f);
+    const ColorImage white = white_like(t.color);
+    ColorImage kp, cp;
+    pass.apply(white, t.depth, kp, t.params, probe);
+    apply_fog_scalar(white, t.depth, cp, t.params, probe);
+    const FogResult<double> fref = fog_scalar<double>(white, t.depth, t.params, probe);
+    kf = factor_error(kp, fref);
+    cf = factor_error(cp, fref);
+  }
+  std::printf("[ worst    ] %-46s %4dx%-4d kernel: f %.2e rel %.2e ulp16 %.2f | scalar<float>: f %.2e rel %.2e ulp16 %.2f\n",
+              describe(pass.last_variant()).c_str(), size.first, size.second, kf, k.max_rel,
+              k.max_ulps, cf, c.max_rel, c.max_ulps);
+
+  EXPECT_EQ(k.nonfinite_from_finite, 0u);
+  EXPECT_EQ(c.nonfinite_from_finite, 0u);
+  EXPECT_LE(kf, kFactorBudget);
+  EXPECT_LE(cf, kFactorBudget);
+  if (format == ColorFormat::rgba32f) {
+    EXPECT_LE(k.max_rel, kColorRelBudget);
+    EXPECT_LE(c.max_rel, kColorRelBudget);
+  } else {
+    EXPECT_LE(k.max_ulps, kHalfUlpBudget);
+    EXPECT_LE(c.max_ulps, kHalfUlpBudget);
+  }
+}
+
+std::string name(const ::testing::TestParamInfo<Param>& info) {
+  const auto [mode, distance, skybox, reversed, format, size] = info.param;
+  std::string n = to_string(mode);
+  for (char& ch : n)
+    if (ch == '-') ch = '_';
+  n += distance ? "_distance" : "_depth";
+  n += skybox ? "_fogsky" : "_skytest";
+  n += reversed ? "_revz" : "_convz";
+  n += format == ColorFormat::rgba16f ? "_f16_" : "_f32_";
+  return n + std::to_string(size.first) + "x" + std::to_string(size.second);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllVariants, KernelVsReference,
+    ::testing::Combine(::testing::Values(KernelMode::linear, KernelMode::linear_step, KernelMode::exp,
+                                         KernelMode::exp2),
+                       ::testing::Bool(), ::testing::Bool(), ::testing::Bool(),
+                       ::testing::Values(ColorFormat::rgba32f, ColorFormat::rgba16f),
+                       ::testing::Values(std::make_pair(1, 1), std::make_pair(7, 5),
+                                         std::make_pair(333, 211), std::make_pair(1920, 1080))),
+    name);
+
+}  // namespace
+}  // namespace fogcl::test

@@ -1,0 +1,146 @@
+#include "test_support.h"
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <random>
+
+#include <Imath/half.h>
+
+namespace fogcl::test {
+
+namespace {
+struct RuntimeHolder {
+  std::unique_ptr<Runtime> runtime;
+  std::unique_ptr<FogPass> pass;
+  std::string error;
+  RuntimeHolder() {
+    try {
+      runtime = std::make_unique<Runtime>();
+      pass = std::make_unique<FogPass>(*runtime);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  }
+};
+RuntimeHolder& holder() {
+  static RuntimeHolder h;
+  return h;
+}
+}  // namespace
+
+Runtime* runtime() { return holder().runtime.get(); }
+const std::string& runtime_error() { return holder().error; }
+FogPass& shared_pass() { return *holder().pass; }
+
+TestFrame make_test_frame(int width, int height, bool reversed_z, ColorFormat format,
+                          std::uint32_t seed, float avoid_distance) {
+  TestFrame t;
+  t.camera.aspect = float(width) / float(height);
+  t.camera.reversed_z = reversed_z;
+  t.params = make_camera_params(t.camera);
+  t.color = ColorImage(width, height, format);
+  t.depth = DepthImage(width, height);
+  std::mt19937 rng(seed * 7919u + unsigned(width) * 31u + unsigned(height));
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double n = t.camera.near_plane, f = t.camera.far_plane;
+  const double zx = t.params.zbuffer_params.x, zy = t.params.zbuffer_params.y;
+  const double sky_raw = reversed_z ? 0.0 : 1.0;
+  const auto& c = t.params.frustum_corners;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      t.color.set_pixel(x, y, glm::vec4(4 * unit(rng), 4 * unit(rng), 4 * unit(rng), unit(rng)));
+      if (unit(rng) < 0.1) {
+        t.depth.at(x, y) = float(sky_raw);
+        continue;
+      }
+      // Independent of fog_math.h: the ray length of the pixel from the corners, in double.
+      const double u = (x + 0.5) / width, v = 1.0 - (y + 0.5) / height;
+      double len2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double b = c[0][k] + (c[1][k] - c[0][k]) * u, tp = c[2][k] + (c[3][k] - c[2][k]) * u;
+        const double r = b + (tp - b) * v;
+        len2 += r * r;
+      }
+      for (;;) {
+        const double eye = n * std::pow(f / n, unit(rng));  // log-uniform eye depth in [n, f]
+        const double raw = double(float((f / eye - zy) / zx));
+        const double l01 = 1.0 / (zx * raw + zy);
+        if (std::fabs(l01 - 0.9999) < 1e-3 || raw < 0.0 || raw > 1.0) continue;
+        const double d_depth = l01 * f - n, d_dist = l01 * std::sqrt(len2);
+        if (avoid_distance > 0 && (std::fabs(d_depth - avoid_distance) < 1e-3 * avoid_distance ||
+                                   std::fabs(d_dist - avoid_distance) < 1e-3 * avoid_distance))
+          continue;
+        t.depth.at(x, y) = float(raw);
+        break;
+      }
+    }
+  }
+  return t;
+}
+
+double half_ulp(double x) {
+  x = std::fabs(x);
+  if (x < 6.103515625e-05) return std::ldexp(1.0, -24);  // subnormal spacing
+  return std::ldexp(1.0, int(std::floor(std::log2(x))) - 10);
+}
+
+ErrorStats compare_color(const ColorImage& got, const FogResult<double>& ref, const ColorImage& in,
+                         const glm::vec3& fog_color) {
+  ErrorStats s;
+  s.pixels = in.pixel_count();
+  for (int y = 0; y < in.height(); ++y) {
+    for (int x = 0; x < in.width(); ++x) {
+      const std::size_t i = std::size_t(y) * in.width() + x;
+      const glm::vec4 g = got.pixel(x, y), c = in.pixel(x, y);
+      for (int ch = 0; ch < 3; ++ch) {
+        const double r = ref.rgba[4 * i + ch];
+        if (std::isfinite(c[ch]) && !std::isfinite(g[ch])) ++s.nonfinite_from_finite;
+        if (std::isnan(r) && std::isnan(g[ch])) continue;
+        if (std::isinf(r) && double(g[ch]) == r) continue;
+        const double err = std::fabs(double(g[ch]) - r);
+        const double scale = std::max({std::fabs(double(c[ch])), std::fabs(double(fog_color[ch])), 1e-30});
+        s.max_abs = std::max(s.max_abs, err);
+        s.max_rel = std::max(s.max_rel, err / scale);
+        s.max_ulps = std::max(s.max_ulps, err / half_ulp(r));
+      }
+      // Alpha passes through untouched: bit-compare.
+      bool alpha_same;
+      if (in.format() == ColorFormat::rgba32f)
+        alpha_same = std::memcmp(&in.rgba32f()[4 * i + 3], &got.rgba32f()[4 * i + 3], 4) == 0;
+      else
+        alpha_same = in.rgba16f()[4 * i + 3] == got.rgba16f()[4 * i + 3];
+      if (!alpha_same) s.max_abs = std::max(s.max_abs, 1e30);
+    }
+  }
+  return s;
+}
+
+double factor_error(const ColorImage& probe, const FogResult<double>& ref) {
+  double worst = 0;
+  for (int y = 0; y < probe.height(); ++y)
+    for (int x = 0; x < probe.width(); ++x) {
+      const double f = ref.factor[std::size_t(y) * probe.width() + x];
+      const glm::vec4 p = probe.pixel(x, y);
+      for (int ch = 0; ch < 3; ++ch) worst = std::max(worst, std::fabs(double(p[ch]) - f));
+    }
+  return worst;
+}
+
+ColorImage white_like(const ColorImage& like) {
+  ColorImage w(like.width(), like.height(), like.format());
+  for (int y = 0; y < like.height(); ++y)
+    for (int x = 0; x < like.width(); ++x) w.set_pixel(x, y, glm::vec4(1.0f));
+  return w;
+}
+
+std::string temp_dir() {
+  static const std::string dir = [] {
+    std::filesystem::path p = FOGCL_TEST_TMP;
+    std::filesystem::create_directories(p);
+    return p.string();
+  }();
+  return dir;
+}
+
+}  // namespace fogcl::test

@@ -1,0 +1,67 @@
+// Shared helpers for the test suite: the OpenCL device (or a skip), synthetic frames and error
+// measurement against the double reference.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "fogcl/fogcl.h"
+
+namespace fogcl::test {
+
+// The runtime for FOGCL_DEVICE (default PoCL CPU), created once; nullptr when no OpenCL device
+// exists (kernel tests then GTEST_SKIP with the reason in runtime_error()).
+Runtime* runtime();
+const std::string& runtime_error();
+// One FogPass shared by the tests (its program cache makes each variant build once).
+FogPass& shared_pass();
+
+#define FOGCL_REQUIRE_DEVICE()                                                        \
+  do {                                                                                \
+    if (::fogcl::test::runtime() == nullptr)                                          \
+      GTEST_SKIP() << "no OpenCL device: " << ::fogcl::test::runtime_error();         \
+  } while (0)
+
+struct TestFrame {
+  ColorImage color;
+  DepthImage depth;
+  PerspectiveCamera camera;
+  CameraParams params;
+};
+
+// A frame with random HDR colors (0..4, alpha 0..1) and depths spread log-uniformly between the
+// near and the far plane, ~10% sky pixels. Depths whose Linear01Depth lies within 1e-3 of the sky
+// threshold, or whose distance (depth- or distance-based) lies within 1e-3 relative of
+// `avoid_distance`, are redrawn, so that discontinuities of the spec (sky test, hard step) do not
+// turn last-ulp differences into full-scale errors.
+TestFrame make_test_frame(int width, int height, bool reversed_z, ColorFormat format,
+                          std::uint32_t seed = 1, float avoid_distance = -1.0f);
+
+struct ErrorStats {
+  double max_abs = 0;   // max |got - ref|
+  double max_rel = 0;   // max |got - ref| / scale, scale = max(|color in|, |fog color|, 1e-30)
+  double max_ulps = 0;  // half storage: max |got - ref| in half ulps at ref
+  std::size_t nonfinite_from_finite = 0;
+  std::size_t pixels = 0;
+};
+
+// Compares the RGB of `got` against the double reference (alpha must match `in` bit for bit;
+// counted as an error otherwise).
+ErrorStats compare_color(const ColorImage& got, const FogResult<double>& ref, const ColorImage& in,
+                         const glm::vec3& fog_color);
+
+// Max |got - ref| of the fog factor, where `probe` is the output of a run with color (1,1,1,1)
+// and fog color 0, which makes each channel equal to f exactly.
+double factor_error(const ColorImage& probe, const FogResult<double>& ref);
+
+// A frame with every color (1, 1, 1, 1), same size and format as `like`.
+ColorImage white_like(const ColorImage& like);
+
+// Size of one half-precision ulp at |x|.
+double half_ulp(double x);
+
+std::string temp_dir();  // a per-run scratch folder
+
+}  // namespace fogcl::test
