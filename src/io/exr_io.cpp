@@ -36,33 +36,15 @@
 #include <OpenEXR/ImfStdIO.h>
 
 #include "fogcl/error.h"
+#include "io/atomic_file.h"
 
 namespace fogcl {
 
-namespace detail {
-
-// The one place that makes a file appear complete or not at all; used by write_exr_rgba,
-// write_exr_depth and write_png_preview (png_preview.cpp declares it; the library has no private
-// io header yet). `body` writes the whole file into `out`, an open binary stream on a temporary
-// file next to `path` (same directory, hence same file system, so the rename is atomic).
-// On success the temporary file is renamed onto `path`; on any failure it is removed and a
-// fogcl::Error "PATH: cannot write KIND: reason" is thrown.
-void write_file_atomically(const std::string& path, const char* kind,
-                           const std::function<void(std::ofstream& out, const std::string& temp_path)>& body);
-
-}  // namespace detail
 
 namespace {
 
 constexpr std::int64_t kMaxPixels = std::int64_t(1) << 31;  // per frame; beyond is treated as corrupt
 
-// Library messages may span lines; a fogcl::Error from this file is one line.
-std::string one_line(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r') c = ' ';
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
 
 std::string box_string(const Imath::Box2i& b) {
   return "(" + std::to_string(b.min.x) + ", " + std::to_string(b.min.y) + ")-(" +
@@ -141,7 +123,7 @@ auto with_read_errors(const std::string& path, Read&& read) -> decltype(read()) 
   } catch (const std::bad_alloc&) {
     throw Error(path + ": cannot read EXR: out of memory");
   } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
-    throw Error(path + ": cannot read EXR: " + one_line(e.what()));
+    throw Error(path + ": cannot read EXR: " + detail::one_line(e.what()));
   } catch (...) {
     throw Error(path + ": cannot read EXR: unknown error");
   }
@@ -192,37 +174,6 @@ void write_float_exr(std::ofstream& out, const std::string& temp_path, const Exr
 
 }  // namespace
 
-namespace detail {
-
-void write_file_atomically(const std::string& path, const char* kind,
-                           const std::function<void(std::ofstream& out, const std::string& temp_path)>& body) {
-  // Unique per process (pid) and per call (counter): concurrent writers never share a temp file.
-  static std::atomic<unsigned long> counter{0};
-  const std::string temp_path =
-      path + ".tmp-" + std::to_string(long(::getpid())) + "-" + std::to_string(counter++);
-  try {
-    {
-      std::ofstream out(temp_path, std::ios::binary | std::ios::trunc);
-      if (!out) throw Error("cannot create temporary file '" + temp_path + "': " + std::strerror(errno));
-      body(out, temp_path);
-      out.close();  // flushes: a full disk shows up here
-      if (out.fail()) throw Error("writing temporary file '" + temp_path + "' failed: " + std::strerror(errno));
-    }
-    std::filesystem::rename(temp_path, path);
-  } catch (const std::exception& e) {
-    std::error_code ignored;
-    std::filesystem::remove(temp_path, ignored);
-    if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr)
-      throw Error(path + ": cannot write " + kind + ": out of memory");
-    throw Error(path + ": cannot write " + kind + ": " + one_line(e.what()));
-  } catch (...) {
-    std::error_code ignored;
-    std::filesystem::remove(temp_path, ignored);
-    throw Error(path + ": cannot write " + kind + ": unknown error");
-  }
-}
-
-}  // namespace detail
 
 ColorImage read_exr_color(const std::string& path, ExrWindows* windows, ColorFormat format) {
   return with_read_errors(path, [&] {

@@ -18,15 +18,10 @@
 
 #include "fogcl/error.h"
 #include "fogcl/exr_io.h"
+#include "io/atomic_file.h"
 
 namespace fogcl {
 
-namespace detail {
-// Defined in exr_io.cpp: writes through a temporary file next to `path` and renames it onto
-// `path`; on failure removes it and throws fogcl::Error "PATH: cannot write KIND: reason".
-void write_file_atomically(const std::string& path, const char* kind,
-                           const std::function<void(std::ofstream& out, const std::string& temp_path)>& body);
-}  // namespace detail
 
 namespace {
 

@@ -1,0 +1,47 @@
+// Internal to the fogcl command-line tool.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "fogcl/fogcl.h"
+
+namespace fogcl::cli {
+
+// The path chosen by --device / FOGCL_DEVICE: an OpenCL device, or "scalar" (the one-thread C++
+// path, also the fallback when a machine has no OpenCL).
+class Backend {
+ public:
+  // choice: "" (FOGCL_DEVICE or cpu), cpu, gpu, scalar or part of a device name.
+  explicit Backend(const std::string& choice);
+  bool is_scalar() const { return pass_ == nullptr; }
+  std::string name() const;  // "scalar" or the OpenCL device's description
+  void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+             const CameraParams& camera, const FogSettings& settings);
+  FogPass* pass() { return pass_.get(); }
+
+ private:
+  std::unique_ptr<Runtime> runtime_;
+  std::unique_ptr<FogPass> pass_;
+};
+
+struct DemoOptions {
+  std::string out_dir = "fogcl-demo";
+  int width = 1280;
+  int height = 720;
+  std::string device;
+};
+int run_demo(const DemoOptions& options);
+
+struct ApplyOptions {
+  std::string color_path, depth_path, out_path, png_path;
+  std::string depth_channel = "Z";
+  float near_plane = 0, far_plane = 0, fov = 0, aspect = 0;  // aspect 0: from the image
+  bool reversed_z = false;
+  FogSettings settings;
+  std::string device;
+  bool verbose = false;
+};
+int run_apply(const ApplyOptions& options);
+
+}  // namespace fogcl::cli
