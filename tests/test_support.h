@@ -65,3 +65,9 @@ double half_ulp(double x);
 std::string temp_dir();  // a per-run scratch folder
 
 }  // namespace fogcl::test
+
+namespace fogcl {
+// Readable parameter names in gtest output.
+inline void PrintTo(KernelMode m, std::ostream* os) { *os << to_string(m); }
+inline void PrintTo(ColorFormat f, std::ostream* os) { *os << to_string(f); }
+}  // namespace fogcl
