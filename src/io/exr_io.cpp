@@ -33,101 +33,33 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfDeepScanLineInputPart.h>
+#include <OpenEXR/ImfDeepScanLineOutputPart.h>
+#include <OpenEXR/ImfDeepTiledInputPart.h>
+#include <OpenEXR/ImfDeepTiledOutputPart.h>
+#include <OpenEXR/ImfInputPart.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfMultiPartOutputFile.h>
+#include <OpenEXR/ImfOutputPart.h>
+#include <OpenEXR/ImfPartType.h>
 #include <OpenEXR/ImfStdIO.h>
+#include <OpenEXR/ImfTiledInputPart.h>
+#include <OpenEXR/ImfTiledOutputPart.h>
+#include <vector>
 
 #include "fogcl/error.h"
 #include "io/atomic_file.h"
+#include "io/exr_common.h"
 
 namespace fogcl {
 
 
 namespace {
 
-constexpr std::int64_t kMaxPixels = std::int64_t(1) << 31;  // per frame; beyond is treated as corrupt
-
-
-std::string box_string(const Imath::Box2i& b) {
-  return "(" + std::to_string(b.min.x) + ", " + std::to_string(b.min.y) + ")-(" +
-         std::to_string(b.max.x) + ", " + std::to_string(b.max.y) + ")";
-}
-
-std::string box_string(const glm::ivec2& min, const glm::ivec2& max) {
-  return box_string(Imath::Box2i(Imath::V2i(min.x, min.y), Imath::V2i(max.x, max.y)));
-}
-
-std::string channel_names(const Imf::ChannelList& channels) {
-  std::string names;
-  for (auto it = channels.begin(); it != channels.end(); ++it) {
-    if (!names.empty()) names += ", ";
-    names += it.name();
-  }
-  return names.empty() ? std::string("none") : names;
-}
-
-Imath::Box2i to_box(const glm::ivec2& min, const glm::ivec2& max) {
-  return Imath::Box2i(Imath::V2i(min.x, min.y), Imath::V2i(max.x, max.y));
-}
-
-bool inside(const Imath::Box2i& inner, const Imath::Box2i& outer) {
-  return inner.min.x >= outer.min.x && inner.min.y >= outer.min.y && inner.max.x <= outer.max.x &&
-         inner.max.y <= outer.max.y;
-}
-
-// Size of an inclusive box along one axis, in 64 bits (max - min overflows int for huge boxes).
-std::int64_t extent(int min, int max) { return std::int64_t(max) - std::int64_t(min) + 1; }
-
-// The frame an EXR file describes: its display window (the frame) and data window (the pixels
-// stored), validated before anything is allocated.
-struct Frame {
-  Imath::Box2i display, data;
-  int width = 0, height = 0;
-};
-
-Frame frame_of(const std::string& path, const Imf::Header& header, ExrWindows* windows) {
-  Frame f;
-  f.display = header.displayWindow();
-  f.data = header.dataWindow();
-  const std::int64_t w = extent(f.display.min.x, f.display.max.x);
-  const std::int64_t h = extent(f.display.min.y, f.display.max.y);
-  if (w < 1 || h < 1)
-    throw Error(path + ": cannot read EXR: empty display window " + box_string(f.display));
-  if (w > std::numeric_limits<int>::max() || h > std::numeric_limits<int>::max() ||
-      w * h > kMaxPixels)  // w, h < 2^31 here, so w * h cannot overflow int64
-    throw Error(path + ": cannot read EXR: display window " + box_string(f.display) + " is " +
-                std::to_string(w) + "x" + std::to_string(h) + " pixels, more than the limit of 2^31");
-  if (extent(f.data.min.x, f.data.max.x) < 1 || extent(f.data.min.y, f.data.max.y) < 1)
-    throw Error(path + ": cannot read EXR: empty data window " + box_string(f.data));
-  if (!inside(f.data, f.display))
-    throw Error(path + ": cannot read EXR: data window " + box_string(f.data) +
-                " is not inside the display window " + box_string(f.display) +
-                " (fogcl's frame is the display window)");
-  f.width = int(w);
-  f.height = int(h);
-  if (windows != nullptr) {
-    windows->display_min = {f.display.min.x, f.display.min.y};
-    windows->display_max = {f.display.max.x, f.display.max.y};
-    windows->data_min = {f.data.min.x, f.data.min.y};
-    windows->data_max = {f.data.max.x, f.data.max.y};
-  }
-  return f;
-}
-
-// Runs `read` and turns whatever OpenEXR (Iex), the standard library or the allocator throws into
-// one fogcl::Error line naming the file. Our own fogcl::Errors already name it and pass through.
-template <class Read>
-auto with_read_errors(const std::string& path, Read&& read) -> decltype(read()) {
-  try {
-    return read();
-  } catch (const Error&) {
-    throw;
-  } catch (const std::bad_alloc&) {
-    throw Error(path + ": cannot read EXR: out of memory");
-  } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
-    throw Error(path + ": cannot read EXR: " + detail::one_line(e.what()));
-  } catch (...) {
-    throw Error(path + ": cannot read EXR: unknown error");
-  }
-}
+using detail::box_string;
+using detail::extent;
+using detail::inside;
+using detail::to_box;
 
 // Checks caller-given windows against an image of width x height.
 void check_windows(const std::string& path, const ExrWindows& w, int width, int height) {
@@ -176,57 +108,23 @@ void write_float_exr(std::ofstream& out, const std::string& temp_path, const Exr
 
 
 ColorImage read_exr_color(const std::string& path, ExrWindows* windows, ColorFormat format) {
-  return with_read_errors(path, [&] {
-    Imf::InputFile file(path.c_str());
-    const Imf::Header& header = file.header();
-    const Imf::ChannelList& channels = header.channels();
-    for (const char* name : {"R", "G", "B"})
-      if (channels.findChannel(name) == nullptr)
-        throw Error(path + ": missing channel " + name + " (channels present: " + channel_names(channels) + ")");
-    const Frame f = frame_of(path, header, windows);
-
-    ColorImage frame(f.width, f.height, ColorFormat::rgba32f);  // starts (0, 0, 0, 0)
-    const std::size_t x_stride = 4 * sizeof(float);
-    const std::size_t y_stride = x_stride * std::size_t(f.width);
-    Imf::FrameBuffer frame_buffer;
-    const char* const names[4] = {"R", "G", "B", "A"};
-    const double fill[4] = {0.0, 0.0, 0.0, 1.0};  // only A can be missing here: opaque
-    for (int c = 0; c < 4; ++c)
-      frame_buffer.insert(names[c], Imf::Slice::Make(Imf::FLOAT, frame.rgba32f() + c, f.display, x_stride,
-                                                     y_stride, 1, 1, fill[c]));
-    file.setFrameBuffer(frame_buffer);
-    file.readPixels(f.data.min.y, f.data.max.y);
-    // Half storage: Imath::half rounds to nearest even (image.h's convert()).
-    return format == ColorFormat::rgba32f ? frame : convert(frame, format);
-  });
+  ExrReadRequest request;
+  ExrInput in = read_exr(path, request);
+  if (windows != nullptr) *windows = in.windows;
+  // Half storage: Imath::half rounds to nearest even (image.h's convert()).
+  return format == ColorFormat::rgba32f ? std::move(in.color) : convert(in.color, format);
 }
 
 DepthImage read_exr_depth(const std::string& path, ExrWindows* windows, const std::string& channel,
                           float outside_value) {
-  return with_read_errors(path, [&] {
-    Imf::InputFile file(path.c_str());
-    const Imf::Header& header = file.header();
-    const Imf::ChannelList& channels = header.channels();
-    std::string name = channel;
-    if (channels.findChannel(name) == nullptr) {
-      // A single-channel file is a depth file whatever its channel is called.
-      Imf::ChannelList::ConstIterator first = channels.begin(), second = first;
-      if (first != channels.end() && ++second == channels.end())
-        name = first.name();
-      else
-        throw Error(path + ": no depth channel '" + channel + "' (channels present: " + channel_names(channels) +
-                    ")");
-    }
-    const Frame f = frame_of(path, header, windows);
-
-    DepthImage depth(f.width, f.height, outside_value);
-    Imf::FrameBuffer frame_buffer;
-    frame_buffer.insert(name, Imf::Slice::Make(Imf::FLOAT, depth.data(), f.display, sizeof(float),
-                                               sizeof(float) * std::size_t(f.width)));
-    file.setFrameBuffer(frame_buffer);
-    file.readPixels(f.data.min.y, f.data.max.y);
-    return depth;
-  });
+  ExrReadRequest request;
+  request.read_color = false;
+  request.depth_channel = channel;
+  request.depth_single_channel_fallback = true;
+  request.depth_outside = outside_value;
+  ExrInput in = read_exr(path, request);
+  if (windows != nullptr) *windows = in.windows;
+  return std::move(in.depth);
 }
 
 void write_exr_rgba(const std::string& path, const ColorImage& image, const ExrWindows* windows) {
@@ -248,6 +146,124 @@ void write_exr_depth(const std::string& path, const DepthImage& depth) {
   static const char* const names[1] = {"Z"};
   detail::write_file_atomically(path, "EXR", [&](std::ofstream& out, const std::string& temp_path) {
     write_float_exr(out, temp_path, w, depth.data(), depth.width(), names, 1);
+  });
+}
+
+namespace {
+
+std::size_t pixel_type_size(Imf::PixelType t) { return t == Imf::HALF ? 2 : 4; }
+
+// A channel of the color part other than the fogged layer's R, G, B, A, kept in the output.
+struct KeptChannel {
+  std::string name;
+  Imf::Channel channel;
+  std::vector<char> pixels;  // data window samples (subsampled as stored)
+  std::size_t row_samples = 0;
+};
+
+}  // namespace
+
+void write_exr_output(const std::string& path, const ColorImage& fogged, const ExrInput& source, bool rgba_only) {
+  if (rgba_only || source.color_part < 0 || source.path.empty()) {
+    write_exr_rgba(path, fogged, &source.windows);
+    return;
+  }
+  if (fogged.empty()) throw Error(path + ": cannot write EXR: the image is empty");
+  check_windows(path, source.windows, fogged.width(), fogged.height());
+  ColorImage converted;  // half images are widened to float (exact)
+  const ColorImage& image =
+      fogged.format() == ColorFormat::rgba32f ? fogged : (converted = convert(fogged, ColorFormat::rgba32f));
+  const std::string prefix = source.layer.empty() ? "" : source.layer + ".";
+  const std::string rgba[4] = {prefix + "R", prefix + "G", prefix + "B", prefix + "A"};
+
+  // The source is opened again: its other parts are copied as stored (no decoding), and the color
+  // part's other channels are read back in their own pixel types.
+  detail::with_read_errors(source.path, [&] {
+    std::ifstream file_stream(source.path, std::ios::binary);
+    if (!file_stream) throw Error(source.path + ": cannot read EXR: cannot open the file: " + std::strerror(errno));
+    Imf::StdIFStream stream(file_stream, source.path.c_str());
+    Imf::MultiPartInputFile in(stream);
+    if (in.parts() != source.parts || source.color_part >= in.parts())
+      throw Error(source.path + ": cannot read EXR: the file changed while fogcl was running");
+
+    std::vector<Imf::Header> headers;
+    for (int p = 0; p < in.parts(); ++p) headers.push_back(in.header(p));
+    Imf::Header& h = headers[std::size_t(source.color_part)];
+    const bool deep = h.hasType() && Imf::isDeepData(h.type());
+    const Imath::Box2i display = h.displayWindow(), data = h.dataWindow();
+
+    // Other flat channels of the color part, read in their own types.
+    std::vector<KeptChannel> kept;
+    if (!deep) {
+      for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+        const std::string name = it.name();
+        if (name == rgba[0] || name == rgba[1] || name == rgba[2] || name == rgba[3]) continue;
+        KeptChannel k{name, it.channel(), {}, 0};
+        k.row_samples = std::size_t(extent(data.min.x, data.max.x) / k.channel.xSampling);
+        const std::size_t rows = std::size_t(extent(data.min.y, data.max.y) / k.channel.ySampling);
+        k.pixels.resize(k.row_samples * rows * pixel_type_size(k.channel.type));
+        kept.push_back(std::move(k));
+      }
+      if (!kept.empty()) {
+        Imf::InputPart part(in, source.color_part);
+        Imf::FrameBuffer fb;
+        for (KeptChannel& k : kept) {
+          const std::size_t size = pixel_type_size(k.channel.type);
+          fb.insert(k.name, Imf::Slice::Make(k.channel.type, k.pixels.data(), data, size, size * k.row_samples,
+                                             k.channel.xSampling, k.channel.ySampling));
+        }
+        part.setFrameBuffer(fb);
+        part.readPixels(data.min.y, data.max.y);
+      }
+    }
+
+    // The color part becomes a flat scanline part: the layer in FLOAT plus the kept channels.
+    Imf::ChannelList channels;
+    for (const KeptChannel& k : kept) channels.insert(k.name, k.channel);
+    for (const std::string& c : rgba) channels.insert(c, Imf::Channel(Imf::FLOAT));
+    h.channels() = channels;
+    for (const char* structural : {"tiles", "chunkCount", "version", "maxSamplesPerPixel"})
+      if (h.find(structural) != h.end()) h.erase(structural);
+    if (h.hasType()) h.setType(Imf::SCANLINEIMAGE);
+    if (h.lineOrder() == Imf::RANDOM_Y) h.lineOrder() = Imf::INCREASING_Y;
+
+    detail::write_file_atomically(path, "EXR", [&](std::ofstream& out, const std::string& temp_path) {
+      Imf::StdOFStream ostream(out, temp_path.c_str());
+      Imf::MultiPartOutputFile file(ostream, headers.data(), int(headers.size()));
+      for (int p = 0; p < in.parts(); ++p) {
+        if (p == source.color_part) {
+          Imf::OutputPart part(file, p);
+          Imf::FrameBuffer fb;
+          const std::size_t x_stride = 4 * sizeof(float), y_stride = x_stride * std::size_t(image.width());
+          for (int c = 0; c < 4; ++c)
+            fb.insert(rgba[c], Imf::Slice::Make(Imf::FLOAT, image.rgba32f() + c, display, x_stride, y_stride));
+          for (KeptChannel& k : kept) {
+            const std::size_t size = pixel_type_size(k.channel.type);
+            fb.insert(k.name, Imf::Slice::Make(k.channel.type, k.pixels.data(), data, size, size * k.row_samples,
+                                               k.channel.xSampling, k.channel.ySampling));
+          }
+          part.setFrameBuffer(fb);
+          part.writePixels(data.max.y - data.min.y + 1);
+          continue;
+        }
+        const Imf::Header& ph = in.header(p);
+        const std::string type = ph.hasType() ? ph.type() : Imf::SCANLINEIMAGE;
+        if (type == Imf::TILEDIMAGE) {
+          Imf::TiledInputPart ip(in, p);
+          Imf::TiledOutputPart(file, p).copyPixels(ip);
+        } else if (type == Imf::DEEPSCANLINE) {
+          Imf::DeepScanLineInputPart ip(in, p);
+          Imf::DeepScanLineOutputPart(file, p).copyPixels(ip);
+        } else if (type == Imf::DEEPTILE) {
+          Imf::DeepTiledInputPart ip(in, p);
+          Imf::DeepTiledOutputPart(file, p).copyPixels(ip);
+        } else {
+          Imf::InputPart ip(in, p);
+          Imf::OutputPart(file, p).copyPixels(ip);
+        }
+      }
+    });
+    return 0;
   });
 }
 

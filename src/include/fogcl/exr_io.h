@@ -1,6 +1,8 @@
 // OpenEXR input and output for the fog pass (DESIGN.md §2: the display window is the frame).
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 
 #include <glm/vec2.hpp>
@@ -19,14 +21,74 @@ struct ExrWindows {
   }
 };
 
+// ---- Renderer output: layers, multi-part files, deep files, camera attributes ----------------
+//
+// What fogcl reads from a renderer's EXR (README "Renderer EXR files"):
+//  - color: the channels LAYER.R, LAYER.G, LAYER.B (LAYER.A optional, 1 when missing) of the
+//    first part that has them; LAYER "" is the unnamed layer (R, G, B, A). HALF or FLOAT; UINT
+//    and subsampled color/depth channels are rejected.
+//  - depth: the channel named by the request, in the color's part or else the first part that
+//    has it (same display and data window as the color).
+//  - deep scanline parts are flattened front to back (samples sorted by Z, premultiplied "over");
+//    the depth is the nearest sample's; a pixel without samples is (0, 0, 0, 0) and background.
+//    Deep tiled parts are rejected.
+
+struct ExrReadRequest {
+  std::string layer;                 // "" = R, G, B, A; "beauty" = beauty.R, beauty.G, ...
+  bool read_color = true;            // false: depth only (a --depth file)
+  std::string depth_channel;         // "" = no depth wanted
+  bool depth_single_channel_fallback = false;  // no such channel: use a one-channel part's channel
+  float depth_outside = 1.0f;        // depth outside the data window / of empty deep pixels
+  std::int64_t max_pixels = std::int64_t(1) << 31;   // per frame (display window); more is corrupt
+  std::int64_t max_deep_samples = std::int64_t(1) << 28;  // per deep part
+};
+
+// A perspective camera read from the standard attributes worldToNDC and worldToCamera (OpenEXR's
+// ImfStandardAttributes.h: camera space looks down +z, NDC (0, 0) is the display window's top left).
+struct ExrCamera {
+  bool present = false;     // both matrices there and they describe a symmetric perspective
+  float fov_y_deg = 0.0f;   // vertical field of view [degrees]
+  float aspect = 0.0f;      // tan(horizontal half fov) / tan(vertical half fov)
+  std::string note;         // why the camera is absent when the matrices exist but do not fit
+};
+
+struct ExrInput {
+  std::string path;          // the file read (or the name given for a memory buffer)
+  ColorImage color;          // display-window frame, float RGBA; empty when !read_color
+  DepthImage depth;          // display-window frame; empty when no depth was asked for
+  ExrWindows windows;        // of the color part (of the depth part when !read_color)
+  int color_part = -1;       // part index of the color (or of the depth when !read_color)
+  int depth_part = -1;
+  int parts = 0;             // parts in the file
+  bool deep = false;         // the color came from a deep part, flattened
+  std::string layer;         // the layer read
+  ExrCamera camera;          // from the color part's attributes
+};
+
+// Reads a renderer's EXR (see above). Throws fogcl::Error "FILE: what: why" for every failure:
+// missing file, not an EXR, truncated or corrupt data, missing or unsupported channels.
+ExrInput read_exr(const std::string& path, const ExrReadRequest& request);
+// The same from bytes in memory (the fuzz target's entry point); `name` appears in messages.
+ExrInput read_exr_memory(const void* data, std::size_t size, const std::string& name,
+                         const ExrReadRequest& request);
+
+// Writes `fogged` (the frame of `source.color`) as the output of `fogcl apply`: the source file's
+// parts, attributes and other channels are kept (other parts copied as they are stored; the color
+// part rewritten as scanlines with the layer's R, G, B, A in float); with `rgba_only`, only
+// R, G, B, A (unnamed layer) and the windows. Written under a temporary name and renamed.
+void write_exr_output(const std::string& path, const ColorImage& fogged, const ExrInput& source,
+                      bool rgba_only);
+
+// ---- Simple files --------------------------------------------------------------------------------
+
 // Reads R, G, B and A (half or float; A missing -> 1) into a frame the size of the display
 // window; pixels outside the data window are (0, 0, 0, 0). Throws fogcl::Error
 // ("FILE: what: why") for a missing, unreadable or non-RGB file.
 ColorImage read_exr_color(const std::string& path, ExrWindows* windows = nullptr,
                           ColorFormat format = ColorFormat::rgba32f);
 
-// Reads raw device depth from `channel` (default "Z"; a single-channel file's only channel is
-// used whatever its name) into a display-window-sized frame; pixels outside the data window get
+// Reads raw device depth from `channel` (default "Z", in any part; a single-channel file's only
+// channel is used whatever its name; deep parts give the nearest sample's depth) into a display-window-sized frame; pixels outside the data window get
 // `outside_value`. Throws fogcl::Error for a missing channel or an unreadable file.
 DepthImage read_exr_depth(const std::string& path, ExrWindows* windows = nullptr,
                           const std::string& channel = "Z", float outside_value = 1.0f);

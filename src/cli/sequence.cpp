@@ -1,0 +1,136 @@
+#include "cli/sequence.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <system_error>
+
+#include "fogcl/error.h"
+
+namespace fogcl::cli {
+
+namespace {
+
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+}  // namespace
+
+FramePattern parse_frame_pattern(const std::string& path) {
+  FramePattern p;
+  p.text = path;
+  // Placeholders are looked for in the file name only: folders may contain '#' or '%'.
+  const std::size_t name_start = path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1;
+  std::size_t found_at = std::string::npos, found_len = 0;
+  int width = 0, count = 0;
+  for (std::size_t i = name_start; i < path.size();) {
+    if (path[i] == '#') {
+      std::size_t j = i;
+      while (j < path.size() && path[j] == '#') ++j;
+      found_at = i, found_len = j - i, width = int(j - i), ++count;
+      i = j;
+    } else if (path[i] == '%') {
+      std::size_t j = i + 1;
+      if (j < path.size() && path[j] == '%') {  // a literal '%'
+        i = j + 1;
+        continue;
+      }
+      bool zero = false;
+      if (j < path.size() && path[j] == '0') zero = true, ++j;
+      int w = 0;
+      while (j < path.size() && is_digit(path[j]) && w < 100) w = w * 10 + (path[j++] - '0');
+      if (j >= path.size() || path[j] != 'd' || (w > 0 && !zero) || w > 32)
+        throw Error("'" + path + "': unsupported frame placeholder at '" + path.substr(i, std::min<std::size_t>(6, path.size() - i)) +
+                    "' (use %d, %0Nd or a run of '#')");
+      found_at = i, found_len = j + 1 - i, width = w == 0 ? 1 : w, ++count;
+      i = j + 1;
+    } else {
+      ++i;
+    }
+  }
+  if (count > 1) throw Error("'" + path + "': more than one frame placeholder in the file name");
+  if (count == 0) return p;
+  p.is_sequence = true;
+  p.width = width;
+  p.prefix = path.substr(0, found_at);
+  p.suffix = path.substr(found_at + found_len);
+  return p;
+}
+
+std::string frame_path(const FramePattern& p, int frame) {
+  if (!p.is_sequence) return p.text;
+  std::string digits = std::to_string(frame);
+  if (int(digits.size()) < p.width) digits.insert(0, std::size_t(p.width) - digits.size(), '0');
+  return p.prefix + digits + p.suffix;
+}
+
+std::vector<int> frames_on_disk(const FramePattern& p) {
+  namespace fs = std::filesystem;
+  std::vector<int> frames;
+  if (!p.is_sequence) return frames;
+  // "out/shot." -> folder "out", name stem "shot."; a trailing "x" keeps "out/" from being a folder
+  // name with an empty file name.
+  const fs::path probe(p.prefix + "x");
+  const fs::path dir = probe.parent_path().empty() ? fs::path(".") : probe.parent_path();
+  std::string stem = probe.filename().string();
+  stem.pop_back();
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= stem.size() + p.suffix.size() || name.compare(0, stem.size(), stem) != 0 ||
+        name.compare(name.size() - p.suffix.size(), p.suffix.size(), p.suffix) != 0)
+      continue;
+    const std::string digits = name.substr(stem.size(), name.size() - stem.size() - p.suffix.size());
+    if (digits.empty() || digits.size() > 9 || !std::all_of(digits.begin(), digits.end(), is_digit)) continue;
+    const int frame = std::stoi(digits);
+    if (fs::path(frame_path(p, frame)).filename().string() == name) frames.push_back(frame);
+  }
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
+std::vector<int> parse_frame_range(const std::string& text) {
+  const auto bad = [&] {
+    return Error("--frames must be FRAME or FIRST-LAST with 0 <= FIRST <= LAST < 10^9 (got '" + text + "')");
+  };
+  const std::size_t dash = text.find('-');
+  const std::string a = text.substr(0, dash), b = dash == std::string::npos ? a : text.substr(dash + 1);
+  for (const std::string& s : {a, b})
+    if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), is_digit)) throw bad();
+  const int first = std::stoi(a), last = std::stoi(b);
+  if (first > last) throw bad();
+  std::vector<int> frames;
+  for (int f = first; f <= last; ++f) frames.push_back(f);
+  return frames;
+}
+
+ProgressBar::ProgressBar(int total, bool enabled)
+    : total_(total), enabled_(enabled && ::isatty(STDERR_FILENO) == 1), start_(std::chrono::steady_clock::now()) {}
+
+void ProgressBar::update(int done) {
+  if (!enabled_) return;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  const int width = 30;
+  const int filled = total_ > 0 ? int(double(width) * done / total_) : width;
+  std::string bar(std::size_t(filled), '=');
+  bar.resize(std::size_t(width), ' ');
+  std::fprintf(stderr, "\r[%s] %d/%d frames  %.2f frames/s", bar.c_str(), done, total_,
+               seconds > 0 ? done / seconds : 0.0);
+  std::fflush(stderr);
+  drawn_ = true;
+}
+
+void ProgressBar::clear() {
+  if (!enabled_ || !drawn_) return;
+  std::fprintf(stderr, "\r\033[K");
+  drawn_ = false;
+}
+
+void ProgressBar::finish() {
+  if (!enabled_ || !drawn_) return;
+  std::fprintf(stderr, "\n");
+  drawn_ = false;
+}
+
+}  // namespace fogcl::cli

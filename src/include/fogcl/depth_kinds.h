@@ -1,0 +1,37 @@
+// What renderers write as depth, turned into the raw device depth the fog pass reads
+// (DESIGN.md §2). OpenEXR's Z is "distance from the viewer"; renderers write it as linear eye
+// depth (along the view axis) or as radial distance from the eye.
+#pragma once
+
+#include <string>
+
+#include "fogcl/camera.h"
+#include "fogcl/image.h"
+
+namespace fogcl {
+
+enum class DepthKind {
+  raw,       // raw device depth in [0, 1] (the depth buffer's value); used as is
+  eye,       // linear eye depth along the view axis [world units] (Unity's LinearEyeDepth)
+  distance,  // radial distance from the eye [world units] (|view-space position|)
+};
+
+const char* to_string(DepthKind kind);
+// "raw", "eye" or "distance"; throws fogcl::Error naming the value otherwise.
+DepthKind parse_depth_kind(const std::string& text);
+
+// The raw device depth of the sky for this camera: 1 (conventional Z) or 0 (reversed Z).
+float sky_raw_depth(const CameraParams& camera);
+
+// raw = (far / eye - y) / x with (x, y) of _ZBufferParams, evaluated in double: the inverse of
+// LinearEyeDepth(raw) = far / (x raw + y), clamped to [0, 1] (nearer than near: the near plane).
+// Background (non-finite, <= 0 or >= far) -> sky.
+double raw_from_eye_depth(double eye, const CameraParams& camera);
+
+// Converts `depth` (the display-window frame, row 0 = top) of `kind` to raw device depth in
+// place. distance: eye = distance * far / |ray(u, v)|, ray(u, v) the pixel's far-plane ray
+// (bilinear in the frustum corners, kernels/fog_math.h), so that the fog pass's own
+// Linear01Depth * |ray| gives back the distance. raw: nothing changes.
+void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera);
+
+}  // namespace fogcl

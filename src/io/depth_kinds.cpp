@@ -1,0 +1,62 @@
+#include "fogcl/depth_kinds.h"
+
+#include <cmath>
+
+#include "fogcl/error.h"
+#include "pass/formulas.h"
+
+namespace fogcl {
+
+// The pixel's uv and its far-plane ray, as the fog pass computes them.
+namespace depth_math = formulas;
+
+const char* to_string(DepthKind kind) {
+  switch (kind) {
+    case DepthKind::raw: return "raw";
+    case DepthKind::eye: return "eye";
+    case DepthKind::distance: return "distance";
+  }
+  return "?";
+}
+
+DepthKind parse_depth_kind(const std::string& text) {
+  for (DepthKind k : {DepthKind::raw, DepthKind::eye, DepthKind::distance})
+    if (text == to_string(k)) return k;
+  throw Error("depth kind must be raw, eye or distance (got '" + text + "')");
+}
+
+float sky_raw_depth(const CameraParams& camera) { return camera.reversed_z ? 0.0f : 1.0f; }
+
+double raw_from_eye_depth(double eye, const CameraParams& camera) {
+  const double far_plane = double(camera.far_plane());
+  if (!std::isfinite(eye) || eye <= 0.0 || eye >= far_plane) return double(sky_raw_depth(camera));
+  const double raw = (far_plane / eye - double(camera.zbuffer_params.y)) / double(camera.zbuffer_params.x);
+  return std::fmin(std::fmax(raw, 0.0), 1.0);  // nearer than the near plane: the near plane
+}
+
+void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera) {
+  if (kind == DepthKind::raw) return;
+  validate(camera);
+  const int w = depth.width(), h = depth.height();
+  const double far_plane = double(camera.far_plane());
+  const auto& c = camera.frustum_corners;
+  for (int y = 0; y < h; ++y) {
+    const double v = depth_math::fog_pixel_v<double>(y, h);
+    for (int x = 0; x < w; ++x) {
+      float& d = depth.at(x, y);
+      double eye = double(d);
+      if (kind == DepthKind::distance) {
+        const double u = depth_math::fog_pixel_u<double>(x, w);
+        double ray[3];
+        for (int k = 0; k < 3; ++k)
+          ray[k] = depth_math::fog_bilerp<double>(c[kBottomLeft][k], c[kBottomRight][k], c[kTopLeft][k],
+                                                  c[kTopRight][k], u, v);
+        const double length = std::sqrt(ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]);
+        eye = eye * far_plane / length;  // non-finite / <= 0 stay so, and become sky below
+      }
+      d = float(raw_from_eye_depth(eye, camera));
+    }
+  }
+}
+
+}  // namespace fogcl
