@@ -1,97 +1,209 @@
 /* deferred_fog.cl — the full-screen deferred fog pass (DESIGN.md §2).
  *
- * One work-item per pixel, global size (width, height). Variant switches (set by the host's
- * build_options(); the variant holds no code for a feature the scene does not use):
- *   FOG_MODE       1 linear, 2 linear hard step (start == end), 3 exp, 4 exp2
- *   FOG_DISTANCE   distance-based fog (radial, needs the corner rays and a sqrt); else depth-based
- *   FOG_SKYBOX     fog the skybox too (no sky test); else sky pixels keep f = 1
- *   REVERSED_Z     depth 1 at near, 0 at far (only changes where a NaN depth lands: at the far end)
- *   FOG_COLOR_HALF color stored as RGBA half (vload_half / vstore_half); else RGBA float
- *   FOG_NATIVE_MATH native_exp2 / native_sqrt (the `fast` precision, with -cl-fast-relaxed-math)
+ * Variant switches, set by the host's build_options(); a variant holds no code for a feature the
+ * scene does not use:
+ *   FOG_MODE          1 linear, 2 linear hard step (start == end), 3 exp, 4 exp2
+ *   FOG_DISTANCE      distance-based fog (corner interpolation and a sqrt); else depth-based
+ *   FOG_SKYBOX        fog the skybox too (no sky test); else sky pixels keep f = 1
+ *   REVERSED_Z        depth 1 at near, 0 at far (decides where a NaN depth lands: the far end)
+ *   FOG_COLOR_HALF    color stored as RGBA half; else RGBA float
+ *   FOG_NATIVE_MATH   native_exp2 / native_sqrt (the `fast` precision, with -cl-fast-relaxed-math)
+ *   FOG_VECTOR_WIDTH  pixels per work-item: 16 on CPU devices, 1 elsewhere.
+ *
+ * Why 16 pixels per work-item on CPUs: PoCL vectorises only across work-items, and its exp2 is
+ * a library call that blocks that. Explicit float16 arithmetic maps straight onto SIMD registers
+ * (and PoCL's float16 exp2 is a vector routine), one lane per pixel; colors are processed as
+ * 4 pixels x RGBA per float16 with the fog factor broadcast to its pixel's channels. GPUs keep
+ * one pixel per work-item, which keeps their memory accesses coalesced.
+ * Global size: (ceil(width / FOG_VECTOR_WIDTH), height).
  */
-#pragma OPENCL FP_CONTRACT OFF /* the same roundings as the scalar path; fma only where written */
-
-#ifdef FOG_NATIVE_MATH
-#define exp2 native_exp2
-#define sqrt native_sqrt
-#endif
-
-#include "fog_math.h"
+#pragma OPENCL FP_CONTRACT OFF /* round like the scalar path: fma only where written */
 
 #ifndef FOG_MODE
 #error "FOG_MODE must be defined: 1 linear, 2 linear step, 3 exp, 4 exp2"
 #endif
-#ifdef REVERSED_Z
-#define FOG_REVERSED 1
-#else
-#define FOG_REVERSED 0
+#ifndef FOG_VECTOR_WIDTH
+#define FOG_VECTOR_WIDTH 1
 #endif
+#ifdef FOG_NATIVE_MATH
+#define exp2 native_exp2
+#define sqrt native_sqrt
+#endif
+#ifdef FOG_DISTANCE
+#define FOG_USE_DISTANCE 1
+#else
+#define FOG_USE_DISTANCE 0
+#endif
+#ifdef FOG_SKYBOX
+#define FOG_USE_SKYBOX 1
+#else
+#define FOG_USE_SKYBOX 0
+#endif
+#ifdef REVERSED_Z
+#define FOG_USE_REVERSED_Z 1
+#else
+#define FOG_USE_REVERSED_Z 0
+#endif
+
+#define FOG_REAL float
+#define FOG_INT int
+#define FOG_NAME(name) name
+#include "fog_math.h"
+#undef FOG_REAL
+#undef FOG_INT
+#undef FOG_NAME
+
+#define FOG_REAL float16
+#define FOG_INT int16
+#define FOG_NAME(name) name##_v
+#include "fog_math.h"
+#undef FOG_REAL
+#undef FOG_INT
+#undef FOG_NAME
+
 #ifdef FOG_COLOR_HALF
 #define COLOR_T half
 #else
-#define COLOR_T float4
+#define COLOR_T float
 #endif
 
-/* fog_params: linear (end, 1 / (end - start)); step (start); exp, exp2 (k) — see fog_math.h.
- * corners: far-plane rays, bottom-left, bottom-right, top-left, top-right (xyz used). */
+/* Per-frame constants, unpacked once per work-item. */
+typedef struct {
+  float zx, zy, near_plane, far_plane, k_a, k_b;
+  float4 fog_color, bl, br, tl, tr;
+  float width, height;
+} FogConstants;
+
+/* One pixel (index i in the frame, column x, row y): the GPU path and the row tails of the CPU
+ * path. color is RGBA at 4 * i. */
+static inline void fog_pixel(global const COLOR_T* color_in, global const float* depth,
+                             global COLOR_T* color_out, size_t i, int x, int y,
+                             const FogConstants* k) {
+  float ray_length = 0.0f;
+#if FOG_USE_DISTANCE
+  const float u = fog_pixel_u((float)x, k->width), v = fog_pixel_v((float)y, k->height);
+  ray_length = fog_ray_length(fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v),
+                              fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
+                              fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v));
+#endif
+  const float f = fog_factor(depth[i], ray_length, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
+                             FOG_USE_REVERSED_Z, k->zx, k->zy, k->near_plane, k->far_plane,
+                             k->k_a, k->k_b);
+#ifdef FOG_COLOR_HALF
+  if (f == 1.0f) {
+    /* Copy the bits: a half -> float -> half trip would quiet a signalling NaN. */
+    vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
+    return;
+  }
+  const float4 c = vload_half4(i, color_in);
+#else
+  const float4 c = vload4(i, color_in);
+#endif
+  const float4 o = (float4)(fog_blend(c.x, k->fog_color.x, f), fog_blend(c.y, k->fog_color.y, f),
+                            fog_blend(c.z, k->fog_color.z, f), c.w /* alpha passes through */);
+#ifdef FOG_COLOR_HALF
+  vstore_half4_rte(o, i, color_out);
+#else
+  vstore4(o, i, color_out);
+#endif
+}
+
+#if FOG_VECTOR_WIDTH == 16
+/* 16 pixels of one row starting at frame index i0, column x0. */
+static inline void fog_pixels16(global const COLOR_T* color_in, global const float* depth,
+                                global COLOR_T* color_out, size_t i0, int x0, int y,
+                                const FogConstants* k) {
+  float16 ray_length = 0.0f;
+#if FOG_USE_DISTANCE
+  const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const float16 u = fog_pixel_u_v((float16)((float)x0) + lane, (float16)k->width);
+  const float16 v = (float16)fog_pixel_v((float)y, k->height);
+  ray_length = fog_ray_length_v(
+      fog_bilerp_v((float16)k->bl.x, (float16)k->br.x, (float16)k->tl.x, (float16)k->tr.x, u, v),
+      fog_bilerp_v((float16)k->bl.y, (float16)k->br.y, (float16)k->tl.y, (float16)k->tr.y, u, v),
+      fog_bilerp_v((float16)k->bl.z, (float16)k->br.z, (float16)k->tl.z, (float16)k->tr.z, u, v));
+#endif
+  const float16 f = fog_factor_v(vload16(0, depth + i0), ray_length, FOG_MODE, FOG_USE_DISTANCE,
+                                 FOG_USE_SKYBOX, FOG_USE_REVERSED_Z, (float16)k->zx,
+                                 (float16)k->zy, (float16)k->near_plane, (float16)k->far_plane,
+                                 (float16)k->k_a, (float16)k->k_b);
+#ifdef FOG_COLOR_HALF
+  /* f == 1 must copy bits (see fog_pixel). All-sky blocks copy; mixed blocks (sky edges) go
+   * pixel by pixel; the rest runs vectorised. */
+  const int16 keep = f == 1.0f;
+  if (all(keep)) {
+    /* vload/vstore: rows need not start at a 32-byte boundary. */
+    global const ushort* src = (global const ushort*)(color_in + 4 * i0);
+    global ushort* dst = (global ushort*)(color_out + 4 * i0);
+    for (uint q = 0; q < 4; ++q) vstore16(vload16(q, src), q, dst);
+    return;
+  }
+  if (any(keep)) {
+    for (int j = 0; j < 16; ++j) fog_pixel(color_in, depth, color_out, i0 + j, x0 + j, y, k);
+    return;
+  }
+#define FOG_LOAD16(q) vload_half16(q, color_in + 4 * i0)
+#define FOG_STORE16(value, q) vstore_half16_rte(value, q, color_out + 4 * i0)
+#else
+#define FOG_LOAD16(q) vload16(q, color_in + 4 * i0)
+#define FOG_STORE16(value, q) vstore16(value, q, color_out + 4 * i0)
+#endif
+  /* 4 pixels x RGBA per float16: broadcast each pixel's factor to its four channels. The
+   * shuffle masks must be literal constants to become one permute instruction. */
+  const float16 fog_rgba = (float16)(k->fog_color.xyz, 0.0f, k->fog_color.xyz, 0.0f,
+                                     k->fog_color.xyz, 0.0f, k->fog_color.xyz, 0.0f);
+#define FOG_QUAD(q)                                                                          \
+  {                                                                                          \
+    const float16 c = FOG_LOAD16(q);                                                         \
+    const float16 fq = shuffle(f, (uint16)(4 * q, 4 * q, 4 * q, 4 * q, 4 * q + 1, 4 * q + 1, \
+                                           4 * q + 1, 4 * q + 1, 4 * q + 2, 4 * q + 2,       \
+                                           4 * q + 2, 4 * q + 2, 4 * q + 3, 4 * q + 3,       \
+                                           4 * q + 3, 4 * q + 3));                           \
+    const float16 o = fog_blend_v(c, fog_rgba, fq);                                          \
+    FOG_STORE16((float16)(o.s012, c.s3, o.s456, c.s7, o.s89a, c.sb, o.scde, c.sf), q);       \
+  }
+  FOG_QUAD(0)
+  FOG_QUAD(1)
+  FOG_QUAD(2)
+  FOG_QUAD(3)
+#undef FOG_QUAD
+#undef FOG_LOAD16
+#undef FOG_STORE16
+}
+#endif
+
 kernel void deferred_fog(global const COLOR_T* color_in, global const float* depth,
                          global COLOR_T* color_out, int width, int height,
                          float4 zbuffer_params, float4 projection_params, float4 corner_bl,
                          float4 corner_br, float4 corner_tl, float4 corner_tr,
                          float4 fog_params, float4 fog_color) {
-  const int x = get_global_id(0);
+  FogConstants k;
+  k.zx = zbuffer_params.x;
+  k.zy = zbuffer_params.y;
+  k.near_plane = projection_params.y;
+  k.far_plane = projection_params.z;
+  k.k_a = fog_params.x;
+  k.k_b = fog_params.y;
+  k.fog_color = fog_color;
+  k.bl = corner_bl;
+  k.br = corner_br;
+  k.tl = corner_tl;
+  k.tr = corner_tr;
+  k.width = (float)width;
+  k.height = (float)height;
   const int y = get_global_id(1);
-  const size_t i = (size_t)y * (size_t)width + (size_t)x;
-
-  const float raw = fog_sanitize_depth(depth[i], FOG_REVERSED);
-  const float linear01 = fog_linear01_depth(raw, zbuffer_params.x, zbuffer_params.y);
-
-  float f = 1.0f;
-#ifndef FOG_SKYBOX
-  if (!fog_is_sky(linear01))
-#endif
-  {
-#ifdef FOG_DISTANCE
-    const float u = fog_pixel_u(x, width);
-    const float v = fog_pixel_v(y, height);
-    const float d = fog_radial_distance(
-        linear01, fog_bilerp(corner_bl.x, corner_br.x, corner_tl.x, corner_tr.x, u, v),
-        fog_bilerp(corner_bl.y, corner_br.y, corner_tl.y, corner_tr.y, u, v),
-        fog_bilerp(corner_bl.z, corner_br.z, corner_tl.z, corner_tr.z, u, v));
-#else
-    const float d = fog_depth_distance(linear01, projection_params.y, projection_params.z);
-#endif
-#if FOG_MODE == 1
-    f = fog_factor_linear(d, fog_params.x, fog_params.y);
-#elif FOG_MODE == 2
-    f = fog_factor_step(d, fog_params.x);
-#elif FOG_MODE == 3
-    f = fog_factor_exp(d, fog_params.x);
-#elif FOG_MODE == 4
-    f = fog_factor_exp2(d, fog_params.x);
-#else
-#error "unknown FOG_MODE"
-#endif
+  const size_t row = (size_t)y * (size_t)width;
+#if FOG_VECTOR_WIDTH == 16
+  const int x0 = get_global_id(0) * 16;
+  if (x0 + 16 <= width) {
+    fog_pixels16(color_in, depth, color_out, row + x0, x0, y, &k);
+  } else {
+    for (int x = x0; x < width; ++x) fog_pixel(color_in, depth, color_out, row + x, x, y, &k);
   }
-
-#ifdef FOG_COLOR_HALF
-  if (f == 1.0f) {
-    /* Copy the bits: a half -> float -> half round trip would quiet a signalling NaN. */
-    ((global ushort4*)color_out)[i] = ((global const ushort4*)color_in)[i];
-    return;
-  }
-  const float4 c = vload_half4(i, color_in);
+#elif FOG_VECTOR_WIDTH == 1
+  const int x = get_global_id(0);
+  fog_pixel(color_in, depth, color_out, row + x, x, y, &k);
 #else
-  const float4 c = color_in[i];
-#endif
-  float4 o;
-  o.x = fog_blend(c.x, fog_color.x, f);
-  o.y = fog_blend(c.y, fog_color.y, f);
-  o.z = fog_blend(c.z, fog_color.z, f);
-  o.w = c.w; /* alpha passes through */
-#ifdef FOG_COLOR_HALF
-  vstore_half4_rte(o, i, color_out);
-#else
-  color_out[i] = o;
+#error "FOG_VECTOR_WIDTH must be 1 or 16"
 #endif
 }

@@ -280,15 +280,27 @@ Variant variant(KernelMode m, bool distance = false, bool sky = false, bool reve
   return v;
 }
 
+DeviceTraits dev(const std::string& opencl_c_version) {
+  DeviceTraits d;
+  d.opencl_c_version = opencl_c_version;
+  return d;
+}
+
 TEST(VariantTest, BuildOptionsExactStrings) {
-  EXPECT_EQ(build_options(variant(KernelMode::exp2)), "-cl-std=CL1.2 -D FOG_MODE=4");
-  EXPECT_EQ(build_options(variant(KernelMode::exp2, true)), "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE");
-  EXPECT_EQ(build_options(variant(KernelMode::linear, false, true)), "-cl-std=CL1.2 -D FOG_MODE=1 -D FOG_SKYBOX");
+  EXPECT_EQ(build_options(variant(KernelMode::exp2)), "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_VECTOR_WIDTH=16");
+  EXPECT_EQ(build_options(variant(KernelMode::exp2, true)),
+            "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE -D FOG_VECTOR_WIDTH=16");
+  EXPECT_EQ(build_options(variant(KernelMode::linear, false, true)),
+            "-cl-std=CL1.2 -D FOG_MODE=1 -D FOG_SKYBOX -D FOG_VECTOR_WIDTH=16");
   EXPECT_EQ(build_options(variant(KernelMode::linear_step, false, false, true, ColorFormat::rgba16f)),
-            "-cl-std=CL1.2 -D FOG_MODE=2 -D REVERSED_Z -D FOG_COLOR_HALF");
+            "-cl-std=CL1.2 -D FOG_MODE=2 -D REVERSED_Z -D FOG_COLOR_HALF -D FOG_VECTOR_WIDTH=16");
   EXPECT_EQ(build_options(variant(KernelMode::exp, true, true, true, ColorFormat::rgba16f, Precision::fast)),
             "-cl-std=CL1.2 -D FOG_MODE=3 -D FOG_DISTANCE -D FOG_SKYBOX -D REVERSED_Z -D FOG_COLOR_HALF "
-            "-D FOG_NATIVE_MATH -cl-fast-relaxed-math");
+            "-D FOG_NATIVE_MATH -cl-fast-relaxed-math -D FOG_VECTOR_WIDTH=16");
+  // Non-CPU devices keep one pixel per work-item.
+  DeviceTraits gpu;
+  gpu.cpu = false;
+  EXPECT_EQ(build_options(variant(KernelMode::exp2), gpu), "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_VECTOR_WIDTH=1");
 }
 
 TEST(VariantTest, BuildOptionsModeNumbers) {
@@ -364,21 +376,21 @@ TEST(VariantTest, BuildOptionsAreAFaithfulCacheKey) {
 
 TEST(VariantTest, BuildOptionsLanguageVersion) {
   const Variant v = variant(KernelMode::exp);
-  EXPECT_TRUE(has_token(build_options(v, "OpenCL C 1.1"), "-cl-std=CL1.1"));
-  EXPECT_FALSE(has_token(build_options(v, "OpenCL C 1.1"), "-cl-std=CL1.2"));
-  EXPECT_TRUE(has_token(build_options(v, "OpenCL C 1.2 pocl"), "-cl-std=CL1.2"));
-  EXPECT_TRUE(has_token(build_options(v, "OpenCL C 2.0"), "-cl-std=CL1.2"));
-  EXPECT_TRUE(has_token(build_options(v, "OpenCL C 3.0 PoCL"), "-cl-std=CL1.2"));
-  EXPECT_EQ(build_options(v), build_options(v, "OpenCL C 1.2"));
+  EXPECT_TRUE(has_token(build_options(v, dev("OpenCL C 1.1")), "-cl-std=CL1.1"));
+  EXPECT_FALSE(has_token(build_options(v, dev("OpenCL C 1.1")), "-cl-std=CL1.2"));
+  EXPECT_TRUE(has_token(build_options(v, dev("OpenCL C 1.2 pocl")), "-cl-std=CL1.2"));
+  EXPECT_TRUE(has_token(build_options(v, dev("OpenCL C 2.0")), "-cl-std=CL1.2"));
+  EXPECT_TRUE(has_token(build_options(v, dev("OpenCL C 3.0 PoCL")), "-cl-std=CL1.2"));
+  EXPECT_EQ(build_options(v), build_options(v, dev("OpenCL C 1.2")));
 }
 
 TEST(VariantTest, BuildOptionsRejectsBadVersion) {
   const Variant v = variant(KernelMode::exp);
   for (const char* version : {"", "garbage", "OpenCL 1.2", "OpenCL C x.y"}) {
-    const std::string msg = error_of([&] { build_options(v, version); });
+    const std::string msg = error_of([&] { build_options(v, dev(version)); });
     EXPECT_MSG_HAS(msg, std::string("'") + version + "'");
   }
-  const std::string msg = error_of([&] { build_options(v, "OpenCL C 1.0"); });
+  const std::string msg = error_of([&] { build_options(v, dev("OpenCL C 1.0")); });
   EXPECT_MSG_HAS(msg, "1.0");
 }
 
@@ -391,7 +403,7 @@ TEST(VariantTest, BuildOptionsForTheRealDevice) {
   FOGCL_REQUIRE_DEVICE();
   const std::string version = device_opencl_c_version(test::runtime()->device());
   EXPECT_EQ(version.rfind("OpenCL C ", 0), 0u) << version;
-  const std::string o = build_options(variant(KernelMode::exp2), version);
+  const std::string o = build_options(variant(KernelMode::exp2), dev(version));
   EXPECT_EQ(o.rfind("-cl-std=CL1.", 0), 0u) << o;
 }
 

@@ -31,8 +31,7 @@ int run_apply(const ApplyOptions& o) {
     std::fprintf(stderr, "variant: %s\n", describe(select_variant(o.settings, params, color.format())).c_str());
     if (!backend.is_scalar() && select_variant(o.settings, params, color.format()).needs_pass())
       std::fprintf(stderr, "build options: %s\n",
-                   build_options(select_variant(o.settings, params, color.format()),
-                                 device_opencl_c_version(backend.pass()->device())).c_str());
+                   backend.pass()->build_options_for(select_variant(o.settings, params, color.format())).c_str());
   }
   ColorImage out;
   backend.apply(color, depth, out, params, o.settings);

@@ -25,8 +25,8 @@ void check_buffer(const cl::Buffer& buffer, const char* name, std::size_t needed
 FogPass::FogPass(cl::Context context, cl::Device device)
     : device_(std::move(device)), programs_(std::move(context)) {
   with_cl_errors([&] {
-    cpu_device_ = device_is_cpu(device_);
-    c_version_ = device_opencl_c_version(device_);
+    traits_.cpu = device_is_cpu(device_);
+    traits_.opencl_c_version = device_opencl_c_version(device_);
   });
 }
 
@@ -35,7 +35,7 @@ FogPass::FogPass(const Runtime& runtime) : FogPass(runtime.context(), runtime.de
 }
 
 cl::Kernel& FogPass::kernel_for(const Variant& variant) {
-  const std::string options = build_options(variant, c_version_);
+  const std::string options = build_options(variant, traits_);
   auto it = kernels_.find(options);
   if (it == kernels_.end()) {
     cl::Program program = programs_.get(device_, "deferred_fog.cl", deferred_fog_cl, options);
@@ -90,8 +90,10 @@ cl::Event FogPass::enqueue(const cl::CommandQueue& queue, const FrameBuffers& fb
     kernel.setArg(10, f4(c[kTopRight]));
     kernel.setArg(11, f4(k.a, k.b, 0.0f, 0.0f));
     kernel.setArg(12, f4(settings.color.r, settings.color.g, settings.color.b, 0.0f));
-    queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(fb.width, fb.height), cl::NullRange,
-                               waits, &done);
+    const int per_item = pixels_per_work_item(traits_);
+    queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+                               cl::NDRange((fb.width + per_item - 1) / per_item, fb.height),
+                               cl::NullRange, waits, &done);
     ++stats_.kernel_dispatches;
     return done;
   });
@@ -115,7 +117,7 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
     const cl::Context& ctx = programs_.context();
     // CPU devices read and write the host images where they are (page-aligned storage);
     // other devices get copies.
-    const cl_mem_flags host = cpu_device_ ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
+    const cl_mem_flags host = traits_.cpu ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
     void* in_ptr = const_cast<void*>(in.data());
     FrameBuffers fb;
     fb.width = in.width();
@@ -127,12 +129,12 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
       fb.color_out = fb.color_in;
     } else {
       fb.color_in = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, in.size_bytes(), in_ptr);
-      fb.color_out = cpu_device_ ? cl::Buffer(ctx, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out.size_bytes(), out.data())
+      fb.color_out = traits_.cpu ? cl::Buffer(ctx, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out.size_bytes(), out.data())
                                  : cl::Buffer(ctx, CL_MEM_WRITE_ONLY, out.size_bytes());
     }
     const cl::Event done = enqueue(queue_, fb, camera, settings);
     const std::vector<cl::Event> after{done};
-    if (cpu_device_) {
+    if (traits_.cpu) {
       // Mapping is what makes a USE_HOST_PTR buffer's contents valid in host memory; on a CPU
       // device it returns the same pointer and copies nothing.
       void* mapped = queue_.enqueueMapBuffer(fb.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes(), &after);

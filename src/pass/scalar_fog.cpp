@@ -6,17 +6,10 @@
 #include <Imath/half.h>
 
 #include "fogcl/variant.h"
+#include "pass/formulas.h"
 #include "settings/fog_coefficients.h"
 
 namespace fogcl {
-namespace detail {
-using std::exp2;
-using std::fma;
-using std::fmax;
-using std::fmin;
-using std::sqrt;
-#include "fog_math.h"
-}  // namespace detail
 
 namespace {
 
@@ -33,6 +26,7 @@ template <class T, class Channel, class Sink>
 void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParams& cam,
                 const Variant& v, const FogSettings& s, Sink&& sink) {
   using namespace detail;
+  using namespace formulas;
   const int w = depth.width(), h = depth.height();
   const FogCoefficients<T> k = fog_coefficients<T>(s, v.mode);
   const T zx = T(cam.zbuffer_params.x), zy = T(cam.zbuffer_params.y);
@@ -40,32 +34,23 @@ void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParam
   const T fog[3] = {T(s.color.r), T(s.color.g), T(s.color.b)};
   const auto& cn = cam.frustum_corners;
   const float* raw_depth = depth.data();
+  const int mode = int(v.mode), distance = v.distance, skybox = v.fog_skybox, reversed = v.reversed_z;
   for (int y = 0; y < h; ++y) {
-    const T vv = fog_pixel_v<T>(y, h);
+    const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-      const T linear01 = fog_linear01_depth(fog_sanitize_depth(T(raw_depth[i]), int(v.reversed_z)), zx, zy);
-      T f = 1;
-      if (v.fog_skybox || !fog_is_sky(linear01)) {
-        T d;
-        if (v.distance) {
-          const T u = fog_pixel_u<T>(x, w);
-          T ray[3];
-          for (int c = 0; c < 3; ++c)
-            ray[c] = fog_bilerp(T(cn[kBottomLeft][c]), T(cn[kBottomRight][c]), T(cn[kTopLeft][c]),
-                                T(cn[kTopRight][c]), u, vv);
-          d = fog_radial_distance(linear01, ray[0], ray[1], ray[2]);
-        } else {
-          d = fog_depth_distance(linear01, near_plane, far_plane);
-        }
-        switch (v.mode) {
-          case KernelMode::linear: f = fog_factor_linear(d, k.a, k.b); break;
-          case KernelMode::linear_step: f = fog_factor_step(d, k.a); break;
-          case KernelMode::exp: f = fog_factor_exp(d, k.a); break;
-          case KernelMode::exp2: f = fog_factor_exp2(d, k.a); break;
-          case KernelMode::none: break;
-        }
+      T ray_length = 0;
+      if (distance) {
+        const T u = fog_pixel_u(T(x), T(w));
+        T ray[3];
+        for (int c = 0; c < 3; ++c)
+          ray[c] = fog_bilerp(T(cn[kBottomLeft][c]), T(cn[kBottomRight][c]), T(cn[kTopLeft][c]),
+                              T(cn[kTopRight][c]), u, vv);
+        ray_length = fog_ray_length(ray[0], ray[1], ray[2]);
       }
+      const T f = v.needs_pass() ? fog_factor(T(raw_depth[i]), ray_length, mode, distance, skybox, reversed, zx, zy,
+                                              near_plane, far_plane, k.a, k.b)
+                                 : T(1);
       const Channel* c = color + 4 * i;
       T rgba[4];
       for (int ch = 0; ch < 3; ++ch) rgba[ch] = fog_blend(T(load_channel(c + ch)), fog[ch], f);

@@ -30,13 +30,16 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
   return v;
 }
 
-std::string build_options(const Variant& v, const std::string& device_c_version) {
+int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }
+
+std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (!v.needs_pass()) throw Error("build_options: the variant needs no kernel (fog is off)");
+  const std::string& version = device.opencl_c_version;
   int major = 0, minor = 0;
-  if (std::sscanf(device_c_version.c_str(), "OpenCL C %d.%d", &major, &minor) != 2)
-    throw Error("device reports an unreadable OpenCL C version '" + device_c_version + "'");
+  if (std::sscanf(version.c_str(), "OpenCL C %d.%d", &major, &minor) != 2)
+    throw Error("device reports an unreadable OpenCL C version '" + version + "'");
   if (major * 10 + minor < 11)
-    throw Error("device OpenCL C version " + device_c_version + " is older than 1.1");
+    throw Error("device OpenCL C version " + version + " is older than 1.1");
   // The kernel uses nothing past OpenCL C 1.2; ask for the newest of 1.1 / 1.2 the device has.
   std::string o = major * 10 + minor >= 12 ? "-cl-std=CL1.2" : "-cl-std=CL1.1";
   o += " -D FOG_MODE=" + std::to_string(int(v.mode));
@@ -45,6 +48,7 @@ std::string build_options(const Variant& v, const std::string& device_c_version)
   if (v.reversed_z) o += " -D REVERSED_Z";
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
+  o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
   return o;
 }
 

@@ -59,6 +59,9 @@ class FogPass {
   // Builds (or finds in the cache) the program of `variant`, e.g. before the first frame.
   void prepare(const Variant& variant);
 
+  // The build options this pass uses for `variant` on its device.
+  std::string build_options_for(const Variant& variant) const { return build_options(variant, traits_); }
+
   const PassStats& stats() const { return stats_; }
   const ProgramCache& programs() const { return programs_; }
   const cl::Device& device() const { return device_; }
@@ -71,8 +74,7 @@ class FogPass {
   cl::Device device_;
   ProgramCache programs_;
   cl::CommandQueue queue_;  // convenience queue; created on first apply() if not given
-  bool cpu_device_ = false;
-  std::string c_version_;
+  DeviceTraits traits_;
   std::map<std::string, cl::Kernel> kernels_;  // by build options
   PassStats stats_;
   Variant last_variant_;

@@ -37,10 +37,18 @@ struct Variant {
 // Validates the settings and derives the variant. Throws fogcl::Error on invalid settings.
 Variant select_variant(const FogSettings& settings, const CameraParams& camera, ColorFormat storage);
 
-// "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE ..." for a device whose CL_DEVICE_OPENCL_C_VERSION
-// is `device_c_version` ("OpenCL C 1.2 ..."). Deterministic: equal variants give equal strings,
-// so the string is the program cache key.
-std::string build_options(const Variant& variant, const std::string& device_c_version = "OpenCL C 1.2");
+// What the build options depend on besides the scene.
+struct DeviceTraits {
+  std::string opencl_c_version = "OpenCL C 1.2";  // CL_DEVICE_OPENCL_C_VERSION
+  bool cpu = true;                                // CL_DEVICE_TYPE_CPU
+};
+
+// Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
+int pixels_per_work_item(const DeviceTraits& device);
+
+// "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE ... -D FOG_VECTOR_WIDTH=16". Deterministic: equal
+// inputs give equal strings, so the string is the program cache key.
+std::string build_options(const Variant& variant, const DeviceTraits& device = {});
 
 // Human-readable, e.g. "exp2 depth sky-test conventional-z rgba32f precise".
 std::string describe(const Variant& variant);
