@@ -1,42 +1,156 @@
+// `fogcl apply`: fogs renderer EXR output, one file or a frame sequence, with one device setup
+// and one program build for the whole sequence.
+#include <unistd.h>
+
 #include <cstdio>
+#include <exception>
+#include <limits>
+#include <string>
+#include <vector>
 
 #include "cli/cli.h"
+#include "cli/sequence.h"
+#include "fogcl/depth_kinds.h"
 #include "fogcl/exr_io.h"
 
 namespace fogcl::cli {
 
-int run_apply(const ApplyOptions& o) {
-  ExrWindows color_windows, depth_windows;
-  const ColorImage color = read_exr_color(o.color_path, &color_windows);
+namespace {
 
+struct FramePaths {
+  std::string color, depth, out, png;
+};
+
+// The camera of one frame: flags win over the color file's worldToNDC / worldToCamera.
+PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std::string* from) {
   PerspectiveCamera camera;
   camera.near_plane = o.near_plane;
   camera.far_plane = o.far_plane;
-  camera.fov_y_deg = o.fov;
   camera.reversed_z = o.reversed_z;
-  camera.aspect = o.aspect != 0.0f ? o.aspect : float(color.width()) / float(color.height());
+  if (o.fov != 0.0f) {
+    camera.fov_y_deg = o.fov;
+    *from = "flags";
+  } else if (color.camera.present) {
+    camera.fov_y_deg = color.camera.fov_y_deg;
+    *from = "worldToNDC";
+  } else {
+    throw Error(color.path + ": no --fov given and the file has no usable camera (" +
+                (color.camera.note.empty() ? std::string("no worldToNDC and worldToCamera attributes")
+                                           : color.camera.note) +
+                ")");
+  }
+  if (o.aspect != 0.0f)
+    camera.aspect = o.aspect;
+  else if (o.fov == 0.0f && color.camera.present)
+    camera.aspect = color.camera.aspect;
+  else
+    camera.aspect = float(color.color.width()) / float(color.color.height());
+  return camera;
+}
+
+void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backend, bool print_setup) {
+  const DepthKind kind = parse_depth_kind(o.depth_kind);
+  // Outside the depth's data window (and in empty deep pixels) there is nothing: background.
+  // Raw depth gets the sky value; eye / distance depth gets +inf, which converts to it.
+  const float outside = kind == DepthKind::raw ? (o.reversed_z ? 0.0f : 1.0f) : std::numeric_limits<float>::infinity();
+
+  ExrReadRequest request;
+  request.layer = o.layer;
+  request.depth_outside = outside;
+  if (paths.depth.empty()) request.depth_channel = o.depth_channel;
+  ExrInput color = read_exr(paths.color, request);
+
+  std::string camera_from;
+  const PerspectiveCamera camera = frame_camera(o, color, &camera_from);
   const CameraParams params = make_camera_params(camera);
   validate(o.settings);
 
-  // Outside the depth's data window there is nothing: treat it as sky.
-  const DepthImage depth = read_exr_depth(o.depth_path, &depth_windows, o.depth_channel,
-                                          o.reversed_z ? 0.0f : 1.0f);
-  if (!(depth_windows == color_windows))
-    throw Error(o.depth_path + ": data/display window differs from " + o.color_path +
-                "'s: depth and color must cover the same pixels");
+  DepthImage depth;
+  if (paths.depth.empty()) {
+    depth = std::move(color.depth);
+  } else {
+    ExrReadRequest depth_request;
+    depth_request.read_color = false;
+    depth_request.depth_channel = o.depth_channel;
+    depth_request.depth_single_channel_fallback = true;
+    depth_request.depth_outside = outside;
+    ExrInput d = read_exr(paths.depth, depth_request);
+    if (!(d.windows == color.windows))
+      throw Error(paths.depth + ": data/display window differs from " + paths.color +
+                  "'s: depth and color must cover the same pixels");
+    depth = std::move(d.depth);
+  }
+  to_raw_depth(depth, kind, params);
 
-  Backend backend(o.device);
-  if (o.verbose) {
+  if (print_setup) {
+    const Variant variant = select_variant(o.settings, params, color.color.format());
     std::fprintf(stderr, "device: %s\n", backend.name().c_str());
-    std::fprintf(stderr, "variant: %s\n", describe(select_variant(o.settings, params, color.format())).c_str());
-    if (!backend.is_scalar() && select_variant(o.settings, params, color.format()).needs_pass())
-      std::fprintf(stderr, "build options: %s\n",
-                   backend.pass()->build_options_for(select_variant(o.settings, params, color.format())).c_str());
+    std::fprintf(stderr, "camera: fov %g deg, aspect %g (from %s), near %g, far %g%s\n", camera.fov_y_deg,
+                 camera.aspect, camera_from.c_str(), camera.near_plane, camera.far_plane,
+                 camera.reversed_z ? ", reversed Z" : "");
+    std::fprintf(stderr, "depth: %s, channel %s%s\n", to_string(kind), o.depth_channel.c_str(),
+                 color.deep ? " (deep color, flattened)" : "");
+    std::fprintf(stderr, "variant: %s\n", describe(variant).c_str());
+    if (!backend.is_scalar() && variant.needs_pass())
+      std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
   }
   ColorImage out;
-  backend.apply(color, depth, out, params, o.settings);
-  write_exr_rgba(o.out_path, out, &color_windows);
-  if (!o.png_path.empty()) write_png_preview(o.png_path, out);
+  backend.apply(color.color, depth, out, params, o.settings);
+  write_exr_output(paths.out, out, color, o.rgba_only);
+  if (!paths.png.empty()) write_png_preview(paths.png, out);
+}
+
+}  // namespace
+
+int run_apply(const ApplyOptions& o) {
+  parse_depth_kind(o.depth_kind);  // a bad kind fails before any file is touched
+  const FramePattern color = parse_frame_pattern(o.color_path);
+  const FramePattern depth = parse_frame_pattern(o.depth_path);
+  const FramePattern out = parse_frame_pattern(o.out_path);
+  const FramePattern png = parse_frame_pattern(o.png_path);
+  if (!color.is_sequence) {
+    for (const FramePattern* p : {&depth, &out, &png})
+      if (p->is_sequence)
+        throw Error("'" + p->text + "' has a frame placeholder but --color '" + o.color_path + "' has none");
+    if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
+    Backend backend(o.device);
+    apply_frame(o, {o.color_path, o.depth_path, o.out_path, o.png_path}, backend, o.verbose);
+    return 0;
+  }
+
+  if (!out.is_sequence)
+    throw Error("--out '" + o.out_path + "' needs a frame placeholder (#### or %04d) when --color is a sequence");
+  if (!o.png_path.empty() && !png.is_sequence)
+    throw Error("--png '" + o.png_path + "' needs a frame placeholder (#### or %04d) when --color is a sequence");
+  const std::vector<int> frames = o.frames.empty() ? frames_on_disk(color) : parse_frame_range(o.frames);
+  if (frames.empty()) throw Error("'" + o.color_path + "': no frames found (give --frames FIRST-LAST)");
+
+  Backend backend(o.device);  // one device, one context, one program cache for every frame
+  ProgressBar progress(int(frames.size()), true);
+  std::vector<std::string> failures;
+  int done = 0;
+  for (int frame : frames) {
+    const FramePaths paths{frame_path(color, frame), o.depth_path.empty() ? "" : frame_path(depth, frame),
+                           frame_path(out, frame), o.png_path.empty() ? "" : frame_path(png, frame)};
+    try {
+      apply_frame(o, paths, backend, o.verbose && done == 0 && failures.empty());
+    } catch (const std::exception& e) {
+      progress.clear();
+      if (!o.keep_going) throw Error("frame " + std::to_string(frame) + ": " + e.what());
+      std::fprintf(stderr, "fogcl: frame %d failed: %s\n", frame, e.what());
+      failures.push_back("frame " + std::to_string(frame) + ": " + e.what());
+    }
+    progress.update(++done);
+  }
+  progress.finish();
+  if (!failures.empty()) {
+    std::fprintf(stderr, "fogcl: error: %zu of %zu frames failed:\n", failures.size(), frames.size());
+    for (const std::string& f : failures) std::fprintf(stderr, "  %s\n", f.c_str());
+    return 1;
+  }
+  if (o.verbose)
+    std::fprintf(stderr, "fogged %zu frames, %zu program build(s)\n", frames.size(),
+                 backend.is_scalar() ? std::size_t(0) : backend.pass()->programs().builds());
   return 0;
 }
 

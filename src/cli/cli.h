@@ -36,7 +36,14 @@ int run_demo(const DemoOptions& options);
 struct ApplyOptions {
   std::string color_path, depth_path, out_path, png_path;
   std::string depth_channel = "Z";
-  float near_plane = 0, far_plane = 0, fov = 0, aspect = 0;  // aspect 0: from the image
+  std::string depth_kind = "raw";  // raw | eye | distance
+  std::string layer;               // "" = the unnamed layer (R, G, B, A)
+  float near_plane = 0, far_plane = 0;
+  float fov = 0;                   // 0: from the color file's worldToNDC / worldToCamera
+  float aspect = 0;                // 0: from the file's camera, else the display window
+  bool rgba_only = false;          // output only R, G, B, A (no other channels, parts, attributes)
+  std::string frames;              // "FIRST-LAST" for sequences; "" = the frames on disk
+  bool keep_going = false;         // sequences: continue past a bad frame
   bool reversed_z = false;
   FogSettings settings;
   std::string device;

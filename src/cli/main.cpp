@@ -39,16 +39,37 @@ int main(int argc, char** argv) {
   fogcl::cli::ApplyOptions ap;
   std::string mode = "exp2", precision = "precise";
   std::vector<float> fog_color;
-  CLI::App* apply_cmd = app.add_subcommand("apply", "Fog an OpenEXR color image using a raw-depth EXR");
-  apply_cmd->add_option("--color", ap.color_path, "Input color EXR (RGBA or RGB, half or float)")->required();
-  apply_cmd->add_option("--depth", ap.depth_path, "Depth EXR: raw device depth in [0, 1], channel Z or the only channel")->required();
+  CLI::App* apply_cmd = app.add_subcommand(
+      "apply", "Fog OpenEXR renderer output (color + depth), one file or a frame sequence");
+  apply_cmd->add_option("--color", ap.color_path,
+                        "Input color EXR (RGBA or RGB, half or float; multi-part, layered or deep); "
+                        "'shot.####.exr' or 'shot.%04d.exr' for a frame sequence")
+      ->required();
+  apply_cmd->add_option("--layer", ap.layer, "Color layer: NAME reads NAME.R, NAME.G, NAME.B, NAME.A (default: R, G, B, A)");
+  apply_cmd->add_option("--depth", ap.depth_path,
+                        "Depth EXR (channel --depth-channel or the only channel); default: the depth "
+                        "channel of the color file, in any part");
   apply_cmd->add_option("--depth-channel", ap.depth_channel, "Name of the depth channel")->capture_default_str();
-  apply_cmd->add_option("--out", ap.out_path, "Output EXR (RGBA float; windows kept)")->required();
+  apply_cmd->add_option("--depth-kind", ap.depth_kind,
+                        "raw: device depth in [0, 1]; eye: linear eye depth; distance: radial distance from "
+                        "the eye (non-finite, <= 0 or >= far is background)")
+      ->capture_default_str();
+  apply_cmd->add_option("--out", ap.out_path,
+                        "Output EXR: the input's parts, channels and attributes with the layer fogged "
+                        "(RGBA float; windows kept)")
+      ->required();
+  apply_cmd->add_flag("--rgba-only", ap.rgba_only, "Write only R, G, B, A (no other channels, parts or attributes)");
   apply_cmd->add_option("--png", ap.png_path, "Also write an 8-bit sRGB PNG preview here");
+  apply_cmd->add_option("--frames", ap.frames, "Sequences: FIRST-LAST (default: the frames found on disk)");
+  apply_cmd->add_flag("--keep-going", ap.keep_going,
+                      "Sequences: continue past a bad frame, list the failures at the end (exit code still 1)");
   apply_cmd->add_option("--near", ap.near_plane, "Camera near plane [world units], > 0")->required();
   apply_cmd->add_option("--far", ap.far_plane, "Camera far plane [world units], > near")->required();
-  apply_cmd->add_option("--fov", ap.fov, "Vertical field of view [degrees], in (0, 180)")->required();
-  apply_cmd->add_option("--aspect", ap.aspect, "Width / height (default: the image's display window)");
+  apply_cmd->add_option("--fov", ap.fov,
+                        "Vertical field of view [degrees], in (0, 180) (default: from the file's worldToNDC "
+                        "and worldToCamera attributes)");
+  apply_cmd->add_option("--aspect", ap.aspect,
+                        "Width / height (default: the file's camera, else the image's display window)");
   apply_cmd->add_flag("--reversed-z", ap.reversed_z, "Depth is reversed Z (1 at near, 0 at far)");
   apply_cmd->add_option("--mode", mode, "Fog mode")
       ->required()

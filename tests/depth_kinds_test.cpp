@@ -1,0 +1,108 @@
+// Depth kinds (src/io/depth_kinds.cpp): eye depth and radial distance to raw device depth, checked
+// by going back with the formulas of DESIGN.md §2 in double and with the camera's geometry.
+#include <cmath>
+#include <limits>
+
+#include "fogcl/depth_kinds.h"
+#include "fogcl/error.h"
+#include "test_support.h"
+
+namespace fogcl::test {
+namespace {
+
+PerspectiveCamera camera(bool reversed) {
+  PerspectiveCamera c;
+  c.fov_y_deg = 50.0f;
+  c.aspect = 1.6f;
+  c.near_plane = 0.3f;
+  c.far_plane = 1000.0f;
+  c.reversed_z = reversed;
+  return c;
+}
+
+// LinearEyeDepth(raw) = 1 / (z raw + w), in double on the float constants.
+double linear_eye_depth(double raw, const CameraParams& p) {
+  return 1.0 / (double(p.zbuffer_params.z) * raw + double(p.zbuffer_params.w));
+}
+
+TEST(DepthKinds, EyeDepthRoundTripsThroughLinearEyeDepth) {
+  for (bool reversed : {false, true}) {
+    const CameraParams p = make_camera_params(camera(reversed));
+    double worst = 0;
+    for (double eye = 0.3; eye < 999.0; eye *= 1.07) {
+      const float raw = float(raw_from_eye_depth(eye, p));
+      EXPECT_GE(raw, 0.0f);
+      EXPECT_LE(raw, 1.0f);
+      worst = std::max(worst, std::fabs(linear_eye_depth(raw, p) - eye) / eye);
+    }
+    std::printf("[ worst    ] eye -> raw -> eye (%s Z): rel %.2e\n", reversed ? "reversed" : "conventional", worst);
+    // float raw depth resolves eye depth to ~far/near * 2^-24 relative in conventional Z.
+    EXPECT_LE(worst, reversed ? 1e-6 : 3e-4);
+  }
+}
+
+TEST(DepthKinds, BackgroundIsTheSkyValue) {
+  for (bool reversed : {false, true}) {
+    const CameraParams p = make_camera_params(camera(reversed));
+    const double sky = reversed ? 0.0 : 1.0;
+    for (double bg : {0.0, -1.0, 1000.0, 5000.0, std::numeric_limits<double>::infinity(),
+                      -std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()})
+      EXPECT_EQ(raw_from_eye_depth(bg, p), sky) << bg;
+    EXPECT_EQ(sky_raw_depth(p), float(sky));
+    EXPECT_NE(raw_from_eye_depth(999.0, p), sky);
+  }
+}
+
+TEST(DepthKinds, DistanceIsDividedByThePixelsRayLength) {
+  const PerspectiveCamera cam = camera(false);
+  const CameraParams p = make_camera_params(cam);
+  const int w = 33, h = 21;
+  DepthImage d(w, h);
+  const double tan_v = std::tan(double(cam.fov_y_deg) * 3.14159265358979323846 / 360.0);
+  const auto ray_len = [&](int x, int y) {  // |ray| / far from the camera's geometry
+    const double u = (x + 0.5) / w, v = 1.0 - (y + 0.5) / h;
+    const double rx = (2 * u - 1) * tan_v * double(cam.aspect), ry = (2 * v - 1) * tan_v;
+    return std::sqrt(rx * rx + ry * ry + 1.0);
+  };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) d.at(x, y) = float((1.0 + (17 * (x + y * w)) % 900) * ray_len(x, y));
+  d.at(0, 0) = std::numeric_limits<float>::infinity();
+  d.at(1, 0) = 0.0f;
+  d.at(2, 0) = float(1000.0 * ray_len(2, 0) * 1.001);  // beyond the far plane along its ray
+  const DepthImage distance = d;
+  to_raw_depth(d, DepthKind::distance, p);
+  double worst = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (y == 0 && x < 3) {
+        EXPECT_EQ(d.at(x, y), 1.0f) << x;
+        continue;
+      }
+      const double back = linear_eye_depth(d.at(x, y), p) * ray_len(x, y);
+      worst = std::max(worst, std::fabs(back - distance.at(x, y)) / distance.at(x, y));
+    }
+  std::printf("[ worst    ] distance -> raw -> distance: rel %.2e\n", worst);
+  EXPECT_LE(worst, 3e-4);
+  // Eye kind ignores the ray; raw kind changes nothing.
+  DepthImage eye = distance, raw = distance;
+  to_raw_depth(eye, DepthKind::eye, p);
+  EXPECT_EQ(eye.at(5, 5), float(raw_from_eye_depth(distance.at(5, 5), p)));
+  EXPECT_NE(eye.at(0, 10), d.at(0, 10));
+  to_raw_depth(raw, DepthKind::raw, p);
+  EXPECT_EQ(raw.at(5, 5), distance.at(5, 5));
+}
+
+TEST(DepthKinds, ParseNamesTheBadValue) {
+  EXPECT_EQ(parse_depth_kind("eye"), DepthKind::eye);
+  EXPECT_EQ(parse_depth_kind("distance"), DepthKind::distance);
+  EXPECT_EQ(parse_depth_kind("raw"), DepthKind::raw);
+  try {
+    parse_depth_kind("linear");
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'linear'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace fogcl::test
