@@ -1,140 +1,340 @@
-// Scalar C++ vs OpenCL vs a memory-copy baseline on the demo scene, in one run so ratios are
-// meaningful. Every benchmark sets bytes processed; fog benchmarks also report their max color
-// error against the float64 path (counter max_err), so speed always comes with its error.
+// fogcl benchmarks (Google Benchmark, one binary, so ratios come from one run).
+//
+// Per resolution (1280x720, 1920x1080, 3840x2160), fog mode (linear, exp, exp2), metric (depth,
+// distance) and color storage (RGBA32F, RGBA16F):
+//   BM_Memcpy            the same bytes copied with 1 and 2 threads: the memory-bandwidth ceiling
+//   BM_Scalar            fogcl's scalar C++ path (one thread, as built for users)
+//   BM_OpenMPSimd        the OpenMP + SIMD C++ peer (-O3 -march=native, 2 threads)
+//   BM_OpenMPSimdFastMath  the same with -ffast-math (vectorised exp2; no NaN/Inf guarantees)
+//   BM_OpenCLDevice      the OpenCL pass, zero-copy buffers, device time from profiling events
+//   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish)
+// Counters: bytes_per_second; vs_memcpy2 = (2-thread memcpy time of the same bytes, measured in this
+// process) / (this time); max_err = max |color - float64 path| (speed always comes with its error).
+// Start-up: BM_ProgramBuild (cold: a never-seen option string; warm: PoCL's disk cache),
+// BM_FirstDispatch, BM_DispatchOverhead (1x1 frame), BM_StartToFirstFrame (whole process path:
+// platform, context, build, one 1080p frame; run it in a fresh process with an empty
+// POCL_CACHE_DIR for the cold figure). bench/run.sh runs everything, PoCL with 1 and 2 threads.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
 #include <memory>
+#include <random>
+#include <thread>
+#include <tuple>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
+#include "deferred_fog_cl.h"
 #include "fogcl/demo_scene.h"
 #include "fogcl/fogcl.h"
+#include "openmp_peer.h"
 
 namespace {
 
 using namespace fogcl;
+using Clock = std::chrono::steady_clock;
 
-// Bytes a fog pass moves per pixel: color in and out, depth in.
-std::size_t frame_bytes(const DemoFrame& f) {
-  return f.color.size_bytes() * 2 + f.depth.size_bytes();
-}
+constexpr int kThreads = 2;  // the CI / development machine
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 const DemoFrame& frame(int w, int h, ColorFormat format) {
   static std::map<std::tuple<int, int, ColorFormat>, DemoFrame> cache;
-  auto key = std::make_tuple(w, h, format);
+  const auto key = std::make_tuple(w, h, format);
   auto it = cache.find(key);
   if (it == cache.end()) it = cache.emplace(key, render_demo_scene(w, h, {}, {}, format)).first;
   return it->second;
 }
 
-FogSettings settings(int mode, bool distance) {
-  FogSettings s;
-  s.mode = mode == 0 ? FogMode::linear : mode == 1 ? FogMode::exp : FogMode::exp2;
-  s.start = 2.0f;
-  s.end = 70.0f;
-  s.density = 0.03f;
-  s.metric = distance ? FogMetric::distance : FogMetric::depth;
-  return s;
+// Bytes a fog pass moves: color read and written, depth read.
+std::size_t pass_bytes(const DemoFrame& f) { return 2 * f.color.size_bytes() + f.depth.size_bytes(); }
+
+// memcpy of the pass's bytes (color in -> out, depth -> scratch) split over `threads` threads.
+void copy_bytes(const DemoFrame& f, ColorImage& out, DepthImage& scratch, int threads) {
+  const auto part = [&](int t) {
+    const std::size_t cb = f.color.size_bytes(), db = f.depth.size_bytes();
+    const std::size_t c0 = cb * t / threads, c1 = cb * (t + 1) / threads;
+    const std::size_t d0 = db * t / threads, d1 = db * (t + 1) / threads;
+    std::memcpy(static_cast<char*>(out.data()) + c0, static_cast<const char*>(f.color.data()) + c0, c1 - c0);
+    std::memcpy(reinterpret_cast<char*>(scratch.data()) + d0, reinterpret_cast<const char*>(f.depth.data()) + d0, d1 - d0);
+  };
+  if (threads == 1) return part(0);
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(part, t);
+  part(0);
+  for (auto& t : pool) t.join();
+}
+
+// The 2-thread memcpy time [s] of a frame's bytes, measured once per process (median of 15).
+double memcpy2_seconds(const DemoFrame& f) {
+  static std::map<const DemoFrame*, double> cache;
+  if (auto it = cache.find(&f); it != cache.end()) return it->second;
+  ColorImage out(f.color.width(), f.color.height(), f.color.format());
+  DepthImage scratch(f.depth.width(), f.depth.height());
+  std::vector<double> t;
+  for (int i = 0; i < 15; ++i) {
+    const auto a = Clock::now();
+    copy_bytes(f, out, scratch, 2);
+    t.push_back(seconds_since(a));
+  }
+  std::sort(t.begin(), t.end());
+  return cache[&f] = t[t.size() / 2];
+}
+
+struct Case {
+  int w, h;
+  FogSettings settings;
+  ColorFormat format;
+};
+
+Case case_of(const benchmark::State& s) {
+  Case c{int(s.range(0)), int(s.range(1)), {}, s.range(4) ? ColorFormat::rgba16f : ColorFormat::rgba32f};
+  c.settings.mode = s.range(2) == 0 ? FogMode::linear : s.range(2) == 1 ? FogMode::exp : FogMode::exp2;
+  c.settings.start = 2.0f;
+  c.settings.end = 70.0f;
+  c.settings.density = 0.03f;
+  c.settings.metric = s.range(3) ? FogMetric::distance : FogMetric::depth;
+  c.settings.color = glm::vec3(0.62f, 0.68f, 0.76f);
+  return c;
 }
 
 double max_error(const ColorImage& out, const DemoFrame& f, const FogSettings& s) {
   const FogResult<double> ref = fog_scalar<double>(f.color, f.depth, f.params, s);
   double worst = 0;
   for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x)
+    for (int x = 0; x < out.width(); ++x) {
+      const glm::vec4 p = out.pixel(x, y);
       for (int c = 0; c < 3; ++c)
-        worst = std::max(worst, std::fabs(double(out.pixel(x, y)[c]) -
-                                          ref.rgba[4 * (std::size_t(y) * out.width() + x) + c]));
+        worst = std::max(worst, std::fabs(double(p[c]) - ref.rgba[4 * (std::size_t(y) * out.width() + x) + c]));
+    }
   return worst;
 }
 
-void set_common(benchmark::State& state, const DemoFrame& f) {
-  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(frame_bytes(f)));
-  state.counters["Mpix/s"] = benchmark::Counter(double(f.color.pixel_count()) * double(state.iterations()),
-                                                benchmark::Counter::kIsRate);
+// Per-iteration seconds of the timed loop: manual time if set, else real time.
+void finish(benchmark::State& state, const DemoFrame& f, double seconds_per_iteration) {
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(pass_bytes(f)));
+  state.counters["vs_memcpy2"] = memcpy2_seconds(f) / seconds_per_iteration;
 }
 
-// The physical limit of a memory-bound pass: copying the same bytes (1 thread).
 void BM_Memcpy(benchmark::State& state) {
   const DemoFrame& f = frame(int(state.range(0)), int(state.range(1)), ColorFormat::rgba32f);
+  const int threads = int(state.range(2));
   ColorImage out(f.color.width(), f.color.height());
-  DepthImage depth_copy(f.depth.width(), f.depth.height());
+  DepthImage scratch(f.depth.width(), f.depth.height());
+  double total = 0;
   for (auto _ : state) {
-    std::memcpy(out.data(), f.color.data(), f.color.size_bytes());
-    std::memcpy(depth_copy.data(), f.depth.data(), f.depth.size_bytes());
-    benchmark::DoNotOptimize(out.data());
+    const auto a = Clock::now();
+    copy_bytes(f, out, scratch, threads);
     benchmark::ClobberMemory();
+    const double s = seconds_since(a);
+    state.SetIterationTime(s);
+    total += s;
   }
-  set_common(state, f);
+  finish(state, f, total / double(state.iterations()));
+}
+
+template <class Run>
+void timed_fog(benchmark::State& state, Run&& run) {
+  const Case c = case_of(state);
+  const DemoFrame& f = frame(c.w, c.h, c.format);
+  ColorImage out(f.color.width(), f.color.height(), f.color.format());
+  double total = 0;
+  for (auto _ : state) {
+    const double s = run(f, out, c.settings);
+    state.SetIterationTime(s);
+    total += s;
+  }
+  finish(state, f, total / double(state.iterations()));
+  state.counters["max_err"] = max_error(out, f, c.settings);
+}
+
+double host_time(const std::function<void()>& fn) {
+  const auto a = Clock::now();
+  fn();
+  return seconds_since(a);
 }
 
 void BM_Scalar(benchmark::State& state) {
-  const DemoFrame& f = frame(int(state.range(0)), int(state.range(1)), ColorFormat(state.range(4)));
-  const FogSettings s = settings(int(state.range(2)), state.range(3) != 0);
-  ColorImage out;
-  for (auto _ : state) {
-    apply_fog_scalar(f.color, f.depth, out, f.params, s);
-    benchmark::DoNotOptimize(out.data());
-  }
-  set_common(state, f);
-  state.counters["max_err"] = max_error(out, f, s);
+  timed_fog(state, [](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    return host_time([&] { apply_fog_scalar(f.color, f.depth, out, f.params, s); });
+  });
 }
 
-// OpenCL through the integration API on zero-copy buffers; device time from profiling events.
-void BM_OpenCL(benchmark::State& state) {
+void BM_OpenMPSimd(benchmark::State& state) {
+  timed_fog(state, [](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    return host_time([&] { bench::openmp_simd_fog(f.color, f.depth, out, f.params, s, kThreads); });
+  });
+}
+
+void BM_OpenMPSimdFastMath(benchmark::State& state) {
+  timed_fog(state, [](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    return host_time([&] { bench::openmp_simd_fastmath_fog(f.color, f.depth, out, f.params, s, kThreads); });
+  });
+}
+
+Runtime* runtime(benchmark::State& state) {
   static std::unique_ptr<Runtime> rt;
-  if (!rt) {
+  static std::string error;
+  if (!rt && error.empty()) {
     try {
       rt = std::make_unique<Runtime>();
     } catch (const std::exception& e) {
-      state.SkipWithError(e.what());
-      return;
+      error = e.what();
     }
   }
-  const DemoFrame& f = frame(int(state.range(0)), int(state.range(1)), ColorFormat(state.range(4)));
-  const FogSettings s = settings(int(state.range(2)), state.range(3) != 0);
-  ColorImage out(f.color.width(), f.color.height(), f.color.format());
-  FogPass pass(*rt);
-  const cl_mem_flags host = rt->is_cpu() ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
-  FrameBuffers fb;
-  fb.width = f.color.width();
-  fb.height = f.color.height();
-  fb.format = f.color.format();
-  fb.color_in = cl::Buffer(rt->context(), CL_MEM_READ_ONLY | host, f.color.size_bytes(), const_cast<void*>(f.color.data()));
-  fb.depth = cl::Buffer(rt->context(), CL_MEM_READ_ONLY | host, f.depth.size_bytes(), const_cast<float*>(f.depth.data()));
-  fb.color_out = cl::Buffer(rt->context(), CL_MEM_WRITE_ONLY | host, out.size_bytes(), out.data());
-  pass.enqueue(rt->queue(), fb, f.params, s).wait();  // builds the variant
-  for (auto _ : state) {
-    cl::Event e = pass.enqueue(rt->queue(), fb, f.params, s);
-    e.wait();
-    const double ns = double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                             e.getProfilingInfo<CL_PROFILING_COMMAND_START>());
-    state.SetIterationTime(ns * 1e-9);
-  }
-  rt->queue().enqueueReadBuffer(fb.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
-  set_common(state, f);
-  state.counters["max_err"] = max_error(out, f, s);
+  if (!rt) state.SkipWithError(error.c_str());
+  return rt.get();
 }
 
-void Args(benchmark::internal::Benchmark* b, bool with_variants) {
-  b->ArgNames({"w", "h", "mode", "dist", "f16"});
-  for (auto [w, h] : {std::pair{1920, 1080}}) {
-    if (!with_variants) {
-      b->Args({w, h, 0, 0, 0});
-      continue;
+FogPass& shared_pass(Runtime& rt) {
+  static FogPass pass(rt);
+  return pass;
+}
+
+void BM_OpenCLDevice(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  FogPass& pass = shared_pass(*rt);
+  const cl_mem_flags host = rt->is_cpu() ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
+  timed_fog(state, [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    // Buffers wrap the same host memory every time (created once per frame and output).
+    static std::map<std::pair<const void*, const void*>, FrameBuffers> buffers;
+    auto key = std::make_pair(f.color.data(), static_cast<const void*>(out.data()));
+    auto it = buffers.find(key);
+    if (it == buffers.end()) {
+      FrameBuffers fb;
+      fb.width = f.color.width();
+      fb.height = f.color.height();
+      fb.format = f.color.format();
+      fb.color_in = cl::Buffer(rt->context(), CL_MEM_READ_ONLY | host, f.color.size_bytes(), const_cast<void*>(f.color.data()));
+      fb.depth = cl::Buffer(rt->context(), CL_MEM_READ_ONLY | host, f.depth.size_bytes(), const_cast<float*>(f.depth.data()));
+      fb.color_out = cl::Buffer(rt->context(), CL_MEM_READ_WRITE | host, out.size_bytes(), out.data());
+      it = buffers.emplace(key, fb).first;
+      pass.enqueue(rt->queue(), fb, f.params, s).wait();  // builds the variant, first dispatch
     }
+    cl::Event e = pass.enqueue(rt->queue(), it->second, f.params, s);
+    e.wait();
+    if (!rt->is_cpu())
+      rt->queue().enqueueReadBuffer(it->second.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
+    else  // make the host view of the USE_HOST_PTR output valid (no copy on CPU devices)
+      rt->queue().enqueueUnmapMemObject(it->second.color_out,
+                                        rt->queue().enqueueMapBuffer(it->second.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes()));
+    return double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
+  });
+}
+
+void BM_OpenCLHostCall(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  FogPass& pass = shared_pass(*rt);
+  timed_fog(state, [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    return host_time([&] { pass.apply(f.color, f.depth, out, f.params, s); });
+  });
+}
+
+Variant bench_variant(ColorFormat format = ColorFormat::rgba32f) {
+  FogSettings s;
+  s.mode = FogMode::exp2;
+  return select_variant(s, make_camera_params({}), format);
+}
+
+// Cold: an option string PoCL has never seen (a nonce define) forces a full compile.
+void BM_ProgramBuild(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  const bool cold = state.range(0) != 0;
+  const FogPass probe(*rt);
+  const std::string base = probe.build_options_for(bench_variant());
+  std::mt19937_64 rng(std::random_device{}());
+  for (auto _ : state) {
+    ProgramCache cache(rt->context());  // empty in-memory cache: only PoCL's disk cache can help
+    const std::string options = cold ? base + " -D FOGCL_NONCE=" + std::to_string(rng()) : base;
+    const auto a = Clock::now();
+    cache.get(rt->device(), "deferred_fog.cl", deferred_fog_cl, options);
+    state.SetIterationTime(seconds_since(a));
+  }
+}
+
+// First dispatch of a new FogPass (program from PoCL's disk cache): kernel creation + launch.
+void BM_FirstDispatch(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  const DemoFrame& f = frame(1920, 1080, ColorFormat::rgba32f);
+  FogSettings s;
+  ColorImage out;
+  for (auto _ : state) {
+    FogPass pass(*rt);
+    pass.prepare(select_variant(s, f.params, f.color.format()));  // build outside the timing
+    const auto a = Clock::now();
+    pass.apply(f.color, f.depth, out, f.params, s);
+    state.SetIterationTime(seconds_since(a));
+  }
+}
+
+// Steady per-dispatch overhead: enqueue to completion of a 1x1 frame.
+void BM_DispatchOverhead(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  FogPass& pass = shared_pass(*rt);
+  const DemoFrame& f = frame(1, 1, ColorFormat::rgba32f);
+  FrameBuffers fb;
+  fb.width = fb.height = 1;
+  fb.color_in = cl::Buffer(rt->context(), CL_MEM_READ_WRITE, 16);
+  fb.depth = cl::Buffer(rt->context(), CL_MEM_READ_WRITE, 4);
+  fb.color_out = cl::Buffer(rt->context(), CL_MEM_READ_WRITE, 16);
+  FogSettings s;
+  pass.enqueue(rt->queue(), fb, f.params, s).wait();
+  for (auto _ : state) {
+    const auto a = Clock::now();
+    pass.enqueue(rt->queue(), fb, f.params, s).wait();
+    state.SetIterationTime(seconds_since(a));
+  }
+}
+
+// Process start to first fogged 1080p frame: platform + context + build + frame. Meant to run
+// once per process (bench/run.sh: cold with an empty POCL_CACHE_DIR, then warm).
+void BM_StartToFirstFrame(benchmark::State& state) {
+  const DemoFrame& f = frame(1920, 1080, ColorFormat::rgba32f);
+  FogSettings s;
+  ColorImage out;
+  for (auto _ : state) {
+    const auto a = Clock::now();
+    Runtime rt;
+    FogPass pass(rt);
+    pass.apply(f.color, f.depth, out, f.params, s);
+    state.SetIterationTime(seconds_since(a));
+  }
+}
+
+void FogArgs(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"w", "h", "mode", "dist", "f16"});
+  for (auto [w, h] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}})
     for (int mode : {0, 1, 2})
       for (int dist : {0, 1})
         for (int f16 : {0, 1}) b->Args({w, h, mode, dist, f16});
-  }
-  b->Unit(benchmark::kMillisecond);
+  b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
 }
 
-BENCHMARK(BM_Memcpy)->Apply([](auto* b) { Args(b, false); });
-BENCHMARK(BM_Scalar)->Apply([](auto* b) { Args(b, true); });
-BENCHMARK(BM_OpenCL)->Apply([](auto* b) { Args(b, true); })->UseManualTime();
+void MemcpyArgs(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"w", "h", "threads"});
+  for (auto [w, h] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}})
+    for (int t : {1, 2}) b->Args({w, h, t});
+  b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
+}
+
+BENCHMARK(BM_Memcpy)->Apply(MemcpyArgs);
+BENCHMARK(BM_Scalar)->Apply(FogArgs);
+BENCHMARK(BM_OpenMPSimd)->Apply(FogArgs);
+BENCHMARK(BM_OpenMPSimdFastMath)->Apply(FogArgs);
+BENCHMARK(BM_OpenCLDevice)->Apply(FogArgs);
+BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
+BENCHMARK(BM_ProgramBuild)->ArgName("cold")->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_FirstDispatch)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_DispatchOverhead)->UseManualTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_StartToFirstFrame)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 

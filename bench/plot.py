@@ -1,0 +1,119 @@
+#!/usr/bin/python3
+"""Reads bench/run.sh's Google Benchmark JSON and writes throughput.png plus a Markdown table
+(table.md): throughput per path per resolution, with the 2-thread memcpy ceiling drawn."""
+import json
+import re
+import sys
+from collections import defaultdict
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/bench")
+runs = json.loads((out / "fog.json").read_text())["benchmarks"]
+pocl1 = json.loads((out / "pocl1.json").read_text())["benchmarks"] if (out / "pocl1.json").exists() else []
+
+MODES = {"0": "linear", "1": "exp", "2": "exp2"}
+PATHS = {
+    "BM_Scalar": "scalar C++ (1 thread)",
+    "BM_OpenMPSimd": "OpenMP+SIMD C++ (2 threads)",
+    "BM_OpenMPSimdFastMath": "OpenMP+SIMD -ffast-math (2 threads)",
+    "BM_OpenCLDevice": "OpenCL PoCL, device time",
+    "BM_OpenCLHostCall": "OpenCL PoCL, host call",
+}
+
+
+def medians(benchmarks):
+    """name -> (args dict, median run)"""
+    found = {}
+    for b in benchmarks:
+        if b.get("aggregate_name", "median") != "median":
+            continue
+        name = b["run_name"] if "run_name" in b else b["name"]
+        parts = name.split("/")
+        args = dict(p.split(":", 1) for p in parts[1:] if ":" in p)
+        found[name] = (parts[0], args, b)
+    return found
+
+
+def gbps(b):
+    return b["bytes_per_second"] / 1e9
+
+
+def ms(b):
+    return b["real_time"] * {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b["time_unit"]]
+
+
+rows = medians(runs)
+resolutions = sorted({(int(a["w"]), int(a["h"])) for _, (n, a, _) in rows.items() if "w" in a and "mode" in a},
+                     key=lambda r: r[0] * r[1])
+memcpy = {(int(a["w"]), int(a["h"]), int(a["threads"])): b for _, (n, a, b) in rows.items() if n == "BM_Memcpy"}
+
+# Plot: one panel per (metric, storage); bars grouped by resolution, exp2 mode shown (the costliest).
+fig, axes = plt.subplots(2, 2, figsize=(14, 9), sharey=True)
+for ax, (dist, f16) in zip(axes.flat, [("0", "0"), ("1", "0"), ("0", "1"), ("1", "1")]):
+    width = 0.8 / len(PATHS)
+    for i, (bench, label) in enumerate(PATHS.items()):
+        ys = []
+        for (w, h) in resolutions:
+            key = [b for _, (n, a, b) in rows.items()
+                   if n == bench and a.get("w") == str(w) and a.get("h") == str(h) and a.get("mode") == "2"
+                   and a.get("dist") == dist and a.get("f16") == f16]
+            ys.append(gbps(key[0]) if key else 0)
+        ax.bar([r + i * width for r in range(len(resolutions))], ys, width, label=label)
+    for r, (w, h) in enumerate(resolutions):
+        if (w, h, 2) in memcpy:
+            ceiling = gbps(memcpy[(w, h, 2)])
+            ax.hlines(ceiling, r - 0.1, r + 0.9, colors="k", linestyles="--",
+                      label="memcpy, 2 threads (ceiling)" if r == 0 else None)
+    ax.set_xticks([r + 0.4 for r in range(len(resolutions))], [f"{w}x{h}" for w, h in resolutions])
+    ax.set_title(f"exp2 fog, {'distance' if dist == '1' else 'depth'}-based, {'RGBA16F' if f16 == '1' else 'RGBA32F'}")
+    ax.set_ylabel("GB/s moved (color in + out, depth in)")
+    ax.set_yscale("log")
+axes.flat[0].legend(fontsize=8)
+fig.suptitle("fogcl throughput per path (higher is better); dashed: 2-thread memcpy of the same bytes")
+fig.tight_layout()
+fig.savefig(out / "throughput.png", dpi=110)
+
+# Table: per resolution / mode / metric / storage: ms and ratio to memcpy2 for each path.
+lines = ["| frame | fog | storage | memcpy 2T ms | scalar ms | OpenMP ms | OpenMP fast-math ms | OpenCL device ms | OpenCL host call ms | OpenCL / memcpy2 | OpenCL vs scalar | max err (OpenCL) |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+by_case = defaultdict(dict)
+for _, (n, a, b) in rows.items():
+    if "mode" in a:
+        by_case[(int(a["w"]), int(a["h"]), a["mode"], a["dist"], a["f16"])][n] = b
+for (w, h, mode, dist, f16), paths in sorted(by_case.items(), key=lambda kv: (kv[0][0] * kv[0][1], kv[0][2:])):
+    def t(name):
+        return f"{ms(paths[name]):.2f}" if name in paths else "-"
+    cl = paths.get("BM_OpenCLDevice")
+    sc = paths.get("BM_Scalar")
+    ratio = f"{cl['vs_memcpy2']:.2f}" if cl else "-"
+    speedup = f"{ms(sc) / ms(cl):.1f}x" if cl and sc else "-"
+    err = f"{cl['max_err']:.1e}" if cl else "-"
+    m2 = f"{ms(memcpy[(w, h, 2)]):.2f}" if (w, h, 2) in memcpy else "-"
+    lines.append(f"| {w}x{h} | {MODES[mode]} {'distance' if dist == '1' else 'depth'} | {'f16' if f16 == '1' else 'f32'} | "
+                 f"{m2} | {t('BM_Scalar')} | {t('BM_OpenMPSimd')} | {t('BM_OpenMPSimdFastMath')} | {t('BM_OpenCLDevice')} | "
+                 f"{t('BM_OpenCLHostCall')} | {ratio} | {speedup} | {err} |")
+
+extra = []
+for _, (n, a, b) in rows.items():
+    if n in ("BM_ProgramBuild", "BM_FirstDispatch", "BM_DispatchOverhead"):
+        label = n + ("" if not a else " " + " ".join(f"{k}={v}" for k, v in a.items() if k not in ("iterations", "manual_time")))
+        extra.append(f"| {label} | {ms(b):.3f} ms |")
+for name in ("start-cold", "start-warm"):
+    p = out / f"{name}.json"
+    if p.exists():
+        for b in json.loads(p.read_text())["benchmarks"]:
+            extra.append(f"| process start to first 1080p frame ({name.split('-')[1]} PoCL cache) | {ms(b):.1f} ms |")
+p1 = medians(pocl1)
+for _, (n, a, b) in p1.items():
+    if n == "BM_OpenCLDevice" and a.get("w") == "1920" and a.get("f16") == "0":
+        two = [x for _, (m, aa, x) in rows.items() if m == n and aa == a]
+        if two:
+            extra.append(f"| PoCL 1 vs 2 threads, 1080p {MODES[a['mode']]} {'distance' if a['dist'] == '1' else 'depth'} | "
+                         f"{ms(b):.2f} ms vs {ms(two[0]):.2f} ms ({ms(b) / ms(two[0]):.2f}x) |")
+(out / "table.md").write_text("\n".join(lines) + "\n\n| start-up and overhead | median |\n|---|---|\n" + "\n".join(extra) + "\n")
+print((out / "table.md").read_text())
