@@ -74,21 +74,9 @@ typedef struct {
   float width, height;
 } FogConstants;
 
-/* One pixel (index i in the frame, column x, row y): the GPU path and the row tails of the CPU
- * path. color is RGBA at 4 * i. */
-static inline void fog_pixel(global const COLOR_T* color_in, global const float* depth,
-                             global COLOR_T* color_out, size_t i, int x, int y,
-                             const FogConstants* k) {
-  float ray_length = 0.0f;
-#if FOG_USE_DISTANCE
-  const float u = fog_pixel_u((float)x, k->width), v = fog_pixel_v((float)y, k->height);
-  ray_length = fog_ray_length(fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v),
-                              fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
-                              fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v));
-#endif
-  const float f = fog_factor(depth[i], ray_length, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
-                             FOG_USE_REVERSED_Z, k->zx, k->zy, k->near_plane, k->far_plane,
-                             k->k_a, k->k_b);
+/* Blends one pixel (index i in the frame; color RGBA at 4 * i) with its fog factor f. */
+static inline void fog_blend_pixel(global const COLOR_T* color_in, global COLOR_T* color_out,
+                                   size_t i, float f, const FogConstants* k) {
 #ifdef FOG_COLOR_HALF
   if (f == 1.0f) {
     /* Copy the bits: a half -> float -> half trip would quiet a signalling NaN. */
@@ -106,6 +94,23 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
 #else
   vstore4(o, i, color_out);
 #endif
+}
+
+/* One pixel at column x, row y: the GPU path and the row tails of the CPU path. */
+static inline void fog_pixel(global const COLOR_T* color_in, global const float* depth,
+                             global COLOR_T* color_out, size_t i, int x, int y,
+                             const FogConstants* k) {
+  float ray_length = 0.0f;
+#if FOG_USE_DISTANCE
+  const float u = fog_pixel_u((float)x, k->width), v = fog_pixel_v((float)y, k->height);
+  ray_length = fog_ray_length(fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v),
+                              fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
+                              fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v));
+#endif
+  const float f = fog_factor(depth[i], ray_length, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
+                             FOG_USE_REVERSED_Z, k->zx, k->zy, k->near_plane, k->far_plane,
+                             k->k_a, k->k_b);
+  fog_blend_pixel(color_in, color_out, i, f, k);
 }
 
 #if FOG_VECTOR_WIDTH == 16
@@ -128,8 +133,8 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
                                  (float16)k->zy, (float16)k->near_plane, (float16)k->far_plane,
                                  (float16)k->k_a, (float16)k->k_b);
 #ifdef FOG_COLOR_HALF
-  /* f == 1 must copy bits (see fog_pixel). All-sky blocks copy; mixed blocks (sky edges) go
-   * pixel by pixel; the rest runs vectorised. */
+  /* f == 1 must copy bits (see fog_blend_pixel). All-sky blocks copy; mixed blocks (sky edges)
+   * blend pixel by pixel; the rest runs vectorised. */
   const int16 keep = f == 1.0f;
   if (all(keep)) {
     /* vload/vstore: rows need not start at a 32-byte boundary. */
@@ -139,7 +144,9 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
     return;
   }
   if (any(keep)) {
-    for (int j = 0; j < 16; ++j) fog_pixel(color_in, depth, color_out, i0 + j, x0 + j, y, k);
+    float factors[16];
+    vstore16(f, 0, factors);
+    for (int j = 0; j < 16; ++j) fog_blend_pixel(color_in, color_out, i0 + j, factors[j], k);
     return;
   }
 #define FOG_LOAD16(q) vload_half16(q, color_in + 4 * i0)
