@@ -238,7 +238,7 @@ void BM_OpenCLHostCall(benchmark::State& state) {
 Variant bench_variant(ColorFormat format = ColorFormat::rgba32f) {
   FogSettings s;
   s.mode = FogMode::exp2;
-  return select_variant(s, make_camera_params({}), format);
+  return select_variant(s, make_camera_params(PerspectiveCamera{}), format);
 }
 
 // Cold: an option string PoCL has never seen (a nonce define) forces a full compile.

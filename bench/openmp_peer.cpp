@@ -30,6 +30,7 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
   const float near_plane = cam.near_plane(), far_plane = cam.far_plane();
   const auto& c = cam.frustum_corners;
   const float fr = fog.r, fg = fog.g, fb = fog.b;
+  const int projection = int(cam.projection);
 #pragma omp parallel num_threads(threads)
   {
     std::vector<float> factor(static_cast<std::size_t>(w));
@@ -47,7 +48,7 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
                                       fog_bilerp(c[0].y, c[1].y, c[2].y, c[3].y, u, vv),
                                       fog_bilerp(c[0].z, c[1].z, c[2].z, c[3].z, u, vv));
         }
-        f[x] = fog_factor(d[x], ray_length, kMode, kDistance, kSkybox, kReversed, zx, zy, near_plane,
+        f[x] = fog_factor(d[x], ray_length, kMode, kDistance, kSkybox, kReversed, projection, zx, zy, near_plane,
                           far_plane, k.a, k.b);
       }
       const Channel* ci = in + 4 * std::size_t(y) * std::size_t(w);

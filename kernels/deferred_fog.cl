@@ -6,6 +6,7 @@
  *   FOG_DISTANCE      distance-based fog (corner interpolation and a sqrt); else depth-based
  *   FOG_SKYBOX        fog the skybox too (no sky test); else sky pixels keep f = 1
  *   REVERSED_Z        depth 1 at near, 0 at far (decides where a NaN depth lands: the far end)
+ *   FOG_PROJECTION    0 perspective (default), 1 reversed-Z infinite far, 2 orthographic
  *   FOG_COLOR_HALF    color stored as RGBA half; else RGBA float
  *   FOG_NATIVE_MATH   native_exp2 / native_sqrt (the `fast` precision, with -cl-fast-relaxed-math)
  *   FOG_VECTOR_WIDTH  pixels per work-item: 16 on CPU devices, 1 elsewhere.
@@ -38,6 +39,9 @@
 #define FOG_USE_SKYBOX 1
 #else
 #define FOG_USE_SKYBOX 0
+#endif
+#ifndef FOG_PROJECTION
+#define FOG_PROJECTION 0
 #endif
 #ifdef REVERSED_Z
 #define FOG_USE_REVERSED_Z 1
@@ -108,7 +112,7 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
                               fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v));
 #endif
   const float f = fog_factor(depth[i], ray_length, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
-                             FOG_USE_REVERSED_Z, k->zx, k->zy, k->near_plane, k->far_plane,
+                             FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx, k->zy, k->near_plane, k->far_plane,
                              k->k_a, k->k_b);
   fog_blend_pixel(color_in, color_out, i, f, k);
 }
@@ -129,7 +133,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
       fog_bilerp_v((float16)k->bl.z, (float16)k->br.z, (float16)k->tl.z, (float16)k->tr.z, u, v));
 #endif
   const float16 f = fog_factor_v(vload16(0, depth + i0), ray_length, FOG_MODE, FOG_USE_DISTANCE,
-                                 FOG_USE_SKYBOX, FOG_USE_REVERSED_Z, (float16)k->zx,
+                                 FOG_USE_SKYBOX, FOG_USE_REVERSED_Z, FOG_PROJECTION, (float16)k->zx,
                                  (float16)k->zy, (float16)k->near_plane, (float16)k->far_plane,
                                  (float16)k->k_a, (float16)k->k_b);
 #ifdef FOG_COLOR_HALF

@@ -7,7 +7,7 @@
  *     same text runs in float for the baseline and in double for the reference.
  * The includer defines FOG_INT and FOG_NAME (and FOG_REAL in OpenCL C); this file has no include
  * guard on purpose. Only operations that exist in both languages appear: + - * /, fma, exp2,
- * sqrt, fmin, fmax and ?: (a per-lane select on vectors in OpenCL C).
+ * expm1, sqrt, fmin, fmax and ?: (a per-lane select on vectors in OpenCL C).
  * Sources: Unity's UnityCG.cginc (Linear01Depth, UNITY_CALC_FOG_FACTOR_RAW) and Catlike Coding,
  * "Rendering 14: Fog" (deferred fog, depth vs distance, the skybox test). */
 
@@ -19,12 +19,15 @@
 #endif
 #endif
 
-/* Fog modes (FOG_MODE in the kernel, KernelMode on the host). */
+/* Fog modes (FOG_MODE in the kernel, KernelMode on the host) and projections (Projection). */
 #ifndef FOG_MODE_LINEAR
 #define FOG_MODE_LINEAR 1
 #define FOG_MODE_STEP 2
 #define FOG_MODE_EXP 3
 #define FOG_MODE_EXP2 4
+#define FOG_PROJECTION_PERSPECTIVE 0
+#define FOG_PROJECTION_INFINITE_FAR 1
+#define FOG_PROJECTION_ORTHOGRAPHIC 2
 #endif
 
 /* Pixel centre to Unity uv: u grows to the right, v grows upwards (row 0 is the top row).
@@ -65,6 +68,16 @@ FOG_FN FOG_REAL FOG_NAME(fog_linear01_depth)(FOG_REAL raw, FOG_REAL zx, FOG_REAL
   return (FOG_REAL)1 / fma(zx, raw, zy);
 }
 
+/* Orthographic depth is linear: Linear01Depth = x * raw + y (lerp(near, far, raw) / far). */
+FOG_FN FOG_REAL FOG_NAME(fog_linear01_depth_ortho)(FOG_REAL raw, FOG_REAL zx, FOG_REAL zy) {
+  return fma(zx, raw, zy);
+}
+
+/* Reversed Z with an infinite far plane: raw = near / eye. raw == 0 gives +inf (sky), never NaN. */
+FOG_FN FOG_REAL FOG_NAME(fog_eye_depth_infinite)(FOG_REAL raw, FOG_REAL near_plane) {
+  return near_plane / raw;
+}
+
 /* Catlike's skybox test, the same in both Z conventions (the far plane is at Linear01 = 1). */
 FOG_FN FOG_INT FOG_NAME(fog_is_sky)(FOG_REAL linear01) { return linear01 > (FOG_REAL)0.9999f; }
 
@@ -101,22 +114,61 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL d, FOG_REAL k) {
   return FOG_NAME(fog_saturate)(exp2(-(t * t)));
 }
 
-/* The fog factor of a pixel from its raw depth: the whole chain of DESIGN.md §2. The int
+/* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky. The int
  * parameters are compile-time constants in the kernel, so the branches a variant does not use
- * fold away. ray_length = |ray(u, v)| is read only when distance-based.
- * k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k). */
+ * fold away. ray_length = |ray(u, v)| is read only when distance-based (perspective only: with
+ * parallel orthographic rays the host folds distance into depth). */
+FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray_length, int distance,
+                                            int reversed_z, int projection, FOG_REAL zx,
+                                            FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
+                                            FOG_INT* sky) {
+  FOG_REAL depth = FOG_NAME(fog_sanitize_depth)(raw, reversed_z);
+  if (projection == FOG_PROJECTION_INFINITE_FAR) {
+    /* Depth 0 is infinitely far: sky, decided on the raw value before any arithmetic. */
+    *sky = depth == (FOG_REAL)0;
+    FOG_REAL eye = FOG_NAME(fog_eye_depth_infinite)(depth, near_plane);
+    return distance ? eye * ray_length : eye - near_plane;
+  }
+  FOG_REAL linear01 = projection == FOG_PROJECTION_ORTHOGRAPHIC
+                          ? FOG_NAME(fog_linear01_depth_ortho)(depth, zx, zy)
+                          : FOG_NAME(fog_linear01_depth)(depth, zx, zy);
+  *sky = FOG_NAME(fog_is_sky)(linear01);
+  return distance ? linear01 * ray_length
+                  : FOG_NAME(fog_depth_distance)(linear01, near_plane, far_plane);
+}
+
+/* The fog factor f of a pixel from its raw depth: the whole chain of DESIGN.md §2.
+ * k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k, density). */
 FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray_length, int mode, int distance,
-                                     int fog_skybox, int reversed_z, FOG_REAL zx, FOG_REAL zy,
-                                     FOG_REAL near_plane, FOG_REAL far_plane, FOG_REAL k_a,
-                                     FOG_REAL k_b) {
-  FOG_REAL linear01 = FOG_NAME(fog_linear01_depth)(FOG_NAME(fog_sanitize_depth)(raw, reversed_z), zx, zy);
-  FOG_REAL d = distance ? linear01 * ray_length
-                        : FOG_NAME(fog_depth_distance)(linear01, near_plane, far_plane);
+                                     int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
+                                     FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
+                                     FOG_REAL k_a, FOG_REAL k_b) {
+  FOG_INT sky;
+  FOG_REAL d = FOG_NAME(fog_view_distance)(raw, ray_length, distance, reversed_z, projection, zx,
+                                           zy, near_plane, far_plane, &sky);
   FOG_REAL f = mode == FOG_MODE_LINEAR ? FOG_NAME(fog_factor_linear)(d, k_a, k_b)
              : mode == FOG_MODE_STEP   ? FOG_NAME(fog_factor_step)(d, k_a)
              : mode == FOG_MODE_EXP    ? FOG_NAME(fog_factor_exp)(d, k_a)
                                        : FOG_NAME(fog_factor_exp2)(d, k_a);
-  return fog_skybox ? f : (FOG_NAME(fog_is_sky)(linear01) ? (FOG_REAL)1 : f);
+  return fog_skybox ? f : (sky ? (FOG_REAL)1 : f);
+}
+
+/* The fog amount 1 - f, without the cancellation of computing 1 - f when f is close to 1:
+ * exp: -expm1(-density d); exp2: -expm1(-(density d)^2). Linear and step: 1 - f (exact where it
+ * matters: f is then far from 1 or exactly 0 / 1). Reported by the scalar path (FogResult). */
+FOG_FN FOG_REAL FOG_NAME(fog_amount)(FOG_REAL raw, FOG_REAL ray_length, int mode, int distance,
+                                     int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
+                                     FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
+                                     FOG_REAL k_a, FOG_REAL k_b) {
+  FOG_INT sky;
+  FOG_REAL d = FOG_NAME(fog_view_distance)(raw, ray_length, distance, reversed_z, projection, zx,
+                                           zy, near_plane, far_plane, &sky);
+  FOG_REAL x = d * k_b; /* exp / exp2: density * d */
+  FOG_REAL a = mode == FOG_MODE_LINEAR ? (FOG_REAL)1 - FOG_NAME(fog_factor_linear)(d, k_a, k_b)
+             : mode == FOG_MODE_STEP   ? (FOG_REAL)1 - FOG_NAME(fog_factor_step)(d, k_a)
+             : mode == FOG_MODE_EXP    ? -expm1(-x)
+                                       : -expm1(-(x * x));
+  return fog_skybox ? FOG_NAME(fog_saturate)(a) : (sky ? (FOG_REAL)0 : FOG_NAME(fog_saturate)(a));
 }
 
 /* Blend one channel: fogColor + f * (c - fogColor). f == 1 returns c untouched (bit-exact, NaN

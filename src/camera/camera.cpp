@@ -20,16 +20,32 @@ std::string str(T v) {
 void validate(const PerspectiveCamera& c) {
   if (!(c.near_plane > 0.0f) || !std::isfinite(c.near_plane))
     throw Error("camera near plane must be finite and > 0 (got " + str(c.near_plane) + ")");
-  if (!(c.far_plane > c.near_plane) || !std::isfinite(c.far_plane))
+  if (c.infinite_far && !c.reversed_z)
+    throw Error("an infinite far plane needs reversed Z (conventional Z loses all depth precision there)");
+  if (c.infinite_far) {
+    // far is ignored; only the fov and aspect remain to check.
+  } else if (!(c.far_plane > c.near_plane) || !std::isfinite(c.far_plane))
     throw Error("camera far plane must be finite and > near (got far " + str(c.far_plane) +
                 ", near " + str(c.near_plane) + ")");
   if (!(c.fov_y_deg > 0.0f && c.fov_y_deg < 180.0f))
     throw Error("camera vertical fov must be in (0, 180) degrees (got " + str(c.fov_y_deg) + ")");
   if (!(c.aspect > 0.0f) || !std::isfinite(c.aspect))
     throw Error("camera aspect must be finite and > 0 (got " + str(c.aspect) + ")");
-  if (!std::isfinite(c.far_plane / c.near_plane))
+  if (!c.infinite_far && !std::isfinite(c.far_plane / c.near_plane))
     throw Error("camera far/near ratio overflows float (far " + str(c.far_plane) + ", near " +
                 str(c.near_plane) + ")");
+}
+
+void validate(const OrthographicCamera& c) {
+  if (!(c.ortho_size > 0.0f) || !std::isfinite(c.ortho_size))
+    throw Error("orthographic size must be finite and > 0 (got " + str(c.ortho_size) + ")");
+  if (!(c.near_plane >= 0.0f) || !std::isfinite(c.near_plane))
+    throw Error("camera near plane must be finite and >= 0 (got " + str(c.near_plane) + ")");
+  if (!(c.far_plane > c.near_plane) || !std::isfinite(c.far_plane))
+    throw Error("camera far plane must be finite and > near (got far " + str(c.far_plane) +
+                ", near " + str(c.near_plane) + ")");
+  if (!(c.aspect > 0.0f) || !std::isfinite(c.aspect))
+    throw Error("camera aspect must be finite and > 0 (got " + str(c.aspect) + ")");
 }
 
 CameraParams make_camera_params(const PerspectiveCamera& c) {
@@ -37,6 +53,22 @@ CameraParams make_camera_params(const PerspectiveCamera& c) {
   const float n = c.near_plane, f = c.far_plane;
   CameraParams p;
   p.reversed_z = c.reversed_z;
+  const double tan_half = std::tan(double(c.fov_y_deg) * 0.5 * 3.14159265358979323846 / 180.0);
+  const auto corners = [&](double z) {
+    const double half_h = tan_half * z, half_w = half_h * double(c.aspect);
+    p.frustum_corners[kBottomLeft] = glm::vec3(float(-half_w), float(-half_h), float(z));
+    p.frustum_corners[kBottomRight] = glm::vec3(float(half_w), float(-half_h), float(z));
+    p.frustum_corners[kTopLeft] = glm::vec3(float(-half_w), float(half_h), float(z));
+    p.frustum_corners[kTopRight] = glm::vec3(float(half_w), float(half_h), float(z));
+  };
+  if (c.infinite_far) {
+    // Eye depth = near / raw; the rays are normalised to view z = 1 so that distance = eye * |ray|.
+    p.projection = Projection::perspective_infinite_far;
+    p.zbuffer_params = glm::vec4(0.0f, 0.0f, 1.0f / n, 0.0f);
+    p.projection_params = glm::vec4(1.0f, n, INFINITY, 0.0f);
+    corners(1.0);
+    return p;
+  }
   // UnityShaderVariables / Camera.cpp: float arithmetic, so x = 1 - y holds exactly and
   // Linear01Depth(1) == 1 for conventional Z.
   if (c.reversed_z) {
@@ -49,15 +81,26 @@ CameraParams make_camera_params(const PerspectiveCamera& c) {
   }
   p.projection_params = glm::vec4(1.0f, n, f, 1.0f / f);
   // Camera.CalculateFrustumCorners(rect 0..1, far): the far-plane rectangle in view space.
-  const double half_h = std::tan(double(c.fov_y_deg) * 0.5 * 3.14159265358979323846 / 180.0) * f;
-  const double half_w = half_h * double(c.aspect);
-  const auto corner = [&](double sx, double sy) {
-    return glm::vec3(float(sx * half_w), float(sy * half_h), f);
-  };
-  p.frustum_corners[kBottomLeft] = corner(-1, -1);
-  p.frustum_corners[kBottomRight] = corner(+1, -1);
-  p.frustum_corners[kTopLeft] = corner(-1, +1);
-  p.frustum_corners[kTopRight] = corner(+1, +1);
+  corners(double(f));
+  return p;
+}
+
+CameraParams make_camera_params(const OrthographicCamera& c) {
+  validate(c);
+  const float n = c.near_plane, f = c.far_plane;
+  CameraParams p;
+  p.projection = Projection::orthographic;
+  p.reversed_z = c.reversed_z;
+  // Eye depth = lerp(near, far, raw) (raw = 1 - raw with reversed Z), as Unity's orthographic
+  // depth; Linear01Depth = eye / far.
+  const float range = (f - n) / f;
+  p.zbuffer_params = c.reversed_z ? glm::vec4(-range, 1.0f, -(f - n), f) : glm::vec4(range, n / f, f - n, n);
+  p.projection_params = glm::vec4(1.0f, n, f, 1.0f / f);
+  const float half_h = c.ortho_size, half_w = c.ortho_size * c.aspect;
+  p.frustum_corners[kBottomLeft] = glm::vec3(-half_w, -half_h, f);
+  p.frustum_corners[kBottomRight] = glm::vec3(half_w, -half_h, f);
+  p.frustum_corners[kTopLeft] = glm::vec3(-half_w, half_h, f);
+  p.frustum_corners[kTopRight] = glm::vec3(half_w, half_h, f);
   return p;
 }
 
@@ -119,15 +162,21 @@ void validate(const CameraParams& p) {
   const float n = p.near_plane(), f = p.far_plane();
   if (!(n > 0.0f) || !std::isfinite(n))
     throw Error("camera params: near (_ProjectionParams.y) must be finite and > 0 (got " + str(n) + ")");
-  if (!(f > n) || !std::isfinite(f))
+  const bool infinite = p.projection == Projection::perspective_infinite_far;
+  if (infinite && !p.reversed_z)
+    throw Error("camera params: an infinite far plane needs reversed Z");
+  if (!(f > n) || (!infinite && !std::isfinite(f)))
     throw Error("camera params: far (_ProjectionParams.z) must be finite and > near (got " + str(f) + ")");
   for (int c = 0; c < 4; ++c)
     if (!std::isfinite(p.zbuffer_params[c]))
       throw Error("camera params: _ZBufferParams component " + std::to_string(c) + " is not finite (got " +
                   str(p.zbuffer_params[c]) + ")");
-  // Linear01Depth must be positive over the whole depth range [0, 1]: x*0 + y > 0 and x*1 + y > 0.
+  // Linear01Depth must be positive over the whole depth range [0, 1]: x*0 + y > 0 and x*1 + y > 0
+  // (perspective) or >= 0 (orthographic, whose near plane may be at 0).
   const float zx = p.zbuffer_params.x, zy = p.zbuffer_params.y;
-  if (!(zy > 0.0f) || !(zx + zy > 0.0f))
+  if (p.projection == Projection::orthographic ? !(zy >= 0.0f && zx + zy >= 0.0f)
+      : p.projection == Projection::perspective ? !(zy > 0.0f && zx + zy > 0.0f)
+                                                : !(p.zbuffer_params.z > 0.0f))
     throw Error("camera params: _ZBufferParams (" + str(zx) + ", " + str(zy) +
                 ") do not describe a perspective depth range (need y > 0 and x + y > 0)");
   for (const glm::vec3& c : p.frustum_corners)

@@ -6,6 +6,7 @@
 
 namespace fogcl::formulas {
 using std::exp2;
+using std::expm1;
 using std::fma;
 using std::fmax;
 using std::fmin;

@@ -20,11 +20,12 @@ float load_channel(const std::uint16_t* p) {
   return float(h);
 }
 
-// The pixel loop shared by every scalar instantiation. Calls sink(i, f, rgba) per pixel with the
-// fog factor and the blended color (alpha passed through), both in T.
+// The pixel loop shared by every scalar instantiation. Calls sink(i, f, amount, rgba) per pixel
+// with the fog factor, the fog amount 1 - f (only if with_amount, else 0) and the blended color
+// (alpha passed through), all in T.
 template <class T, class Channel, class Sink>
 void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParams& cam,
-                const Variant& v, const FogSettings& s, Sink&& sink) {
+                const Variant& v, const FogSettings& s, bool with_amount, Sink&& sink) {
   using namespace detail;
   using namespace formulas;
   const int w = depth.width(), h = depth.height();
@@ -35,6 +36,7 @@ void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParam
   const auto& cn = cam.frustum_corners;
   const float* raw_depth = depth.data();
   const int mode = int(v.mode), distance = v.distance, skybox = v.fog_skybox, reversed = v.reversed_z;
+  const int projection = int(v.projection);
   for (int y = 0; y < h; ++y) {
     const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
@@ -48,14 +50,18 @@ void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParam
                               T(cn[kTopRight][c]), u, vv);
         ray_length = fog_ray_length(ray[0], ray[1], ray[2]);
       }
-      const T f = v.needs_pass() ? fog_factor(T(raw_depth[i]), ray_length, mode, distance, skybox, reversed, zx, zy,
-                                              near_plane, far_plane, k.a, k.b)
+      const T f = v.needs_pass() ? fog_factor(T(raw_depth[i]), ray_length, mode, distance, skybox,
+                                              reversed, projection, zx, zy, near_plane, far_plane, k.a, k.b)
                                  : T(1);
+      const T amount = with_amount && v.needs_pass()
+                           ? fog_amount(T(raw_depth[i]), ray_length, mode, distance, skybox, reversed,
+                                        projection, zx, zy, near_plane, far_plane, k.a, k.b)
+                           : T(0);
       const Channel* c = color + 4 * i;
       T rgba[4];
       for (int ch = 0; ch < 3; ++ch) rgba[ch] = fog_blend(T(load_channel(c + ch)), fog[ch], f);
       rgba[3] = T(load_channel(c + 3));
-      sink(i, f, rgba);
+      sink(i, f, amount, rgba);
     }
   }
 }
@@ -63,11 +69,11 @@ void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParam
 // Runs fog_pixels with the channel type of the image's storage.
 template <class T, class Sink>
 void fog_image(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
-               const Variant& v, const FogSettings& s, Sink&& sink) {
+               const Variant& v, const FogSettings& s, bool with_amount, Sink&& sink) {
   if (in.format() == ColorFormat::rgba32f)
-    fog_pixels<T>(in.rgba32f(), depth, cam, v, s, sink);
+    fog_pixels<T>(in.rgba32f(), depth, cam, v, s, with_amount, sink);
   else
-    fog_pixels<T>(in.rgba16f(), depth, cam, v, s, sink);
+    fog_pixels<T>(in.rgba16f(), depth, cam, v, s, with_amount, sink);
 }
 
 Variant checked_variant(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
@@ -94,12 +100,12 @@ void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage&
   auto* dst = static_cast<std::byte*>(out.data());
   if (in.format() == ColorFormat::rgba32f) {
     float* o = out.rgba32f();
-    fog_image<float>(in, depth, cam, v, s, [&](std::size_t i, float, const float* rgba) {
+    fog_image<float>(in, depth, cam, v, s, false, [&](std::size_t i, float, float, const float* rgba) {
       for (int c = 0; c < 4; ++c) o[4 * i + c] = rgba[c];
     });
   } else {
     std::uint16_t* o = out.rgba16f();
-    fog_image<float>(in, depth, cam, v, s, [&](std::size_t i, float f, const float* rgba) {
+    fog_image<float>(in, depth, cam, v, s, false, [&](std::size_t i, float f, float, const float* rgba) {
       if (f == 1.0f) {  // keep the bits: a half -> float -> half trip would quiet a signalling NaN
         std::memcpy(dst + i * pixel_bytes, src + i * pixel_bytes, pixel_bytes);
         return;
@@ -119,8 +125,10 @@ FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const Cam
   r.height = in.height();
   r.rgba.resize(4 * in.pixel_count());
   r.factor.resize(in.pixel_count());
-  fog_image<T>(in, depth, cam, v, s, [&](std::size_t i, T f, const T* rgba) {
+  r.amount.resize(in.pixel_count());
+  fog_image<T>(in, depth, cam, v, s, true, [&](std::size_t i, T f, T amount, const T* rgba) {
     r.factor[i] = f;
+    r.amount[i] = amount;
     for (int c = 0; c < 4; ++c) r.rgba[4 * i + c] = rgba[c];
   });
   return r;

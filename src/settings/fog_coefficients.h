@@ -11,7 +11,7 @@ namespace fogcl::detail {
 template <class T>
 struct FogCoefficients {
   T a = 0;  // linear: end; step: start; exp: density * log2(e); exp2: density / sqrt(ln 2)
-  T b = 0;  // linear: 1 / (end - start); otherwise unused
+  T b = 0;  // linear: 1 / (end - start); exp, exp2: density (for the fog amount); step: unused
 };
 
 template <class T>
@@ -29,9 +29,11 @@ FogCoefficients<T> fog_coefficients(const FogSettings& s, KernelMode mode) {
       break;
     case KernelMode::exp:
       c.a = T(s.density) * T(kLog2e);
+      c.b = T(s.density);
       break;
     case KernelMode::exp2:
       c.a = T(s.density) * T(kInvSqrtLn2);
+      c.b = T(s.density);
       break;
     case KernelMode::none:
       break;

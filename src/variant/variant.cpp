@@ -22,7 +22,10 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
       v.mode = s.mode == FogMode::exp ? KernelMode::exp : KernelMode::exp2;
       break;
   }
-  v.distance = s.metric == FogMetric::distance;
+  // Orthographic rays are parallel to the view axis: distance-based fog is depth-based fog, so
+  // the variant carries no ray interpolation and no sqrt for it.
+  v.projection = camera.projection;
+  v.distance = s.metric == FogMetric::distance && camera.projection != Projection::orthographic;
   v.fog_skybox = s.fog_skybox;
   v.reversed_z = camera.reversed_z;
   v.storage = storage;
@@ -46,6 +49,7 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.distance) o += " -D FOG_DISTANCE";
   if (v.fog_skybox) o += " -D FOG_SKYBOX";
   if (v.reversed_z) o += " -D REVERSED_Z";
+  if (v.projection != Projection::perspective) o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
@@ -68,7 +72,9 @@ std::string describe(const Variant& v) {
   std::string d = to_string(v.mode);
   d += v.distance ? " distance" : " depth";
   d += v.fog_skybox ? " fog-skybox" : " sky-test";
-  d += v.reversed_z ? " reversed-z " : " conventional-z ";
+  d += v.reversed_z ? " reversed-z" : " conventional-z";
+  d += v.projection == Projection::orthographic ? " orthographic "
+       : v.projection == Projection::perspective_infinite_far ? " infinite-far " : " ";
   d += to_string(v.storage);
   d += ' ';
   d += to_string(v.precision);

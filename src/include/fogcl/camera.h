@@ -18,19 +18,43 @@ struct PerspectiveCamera {
   float near_plane = 0.3f;         // [world units], finite and > 0; Unity default 0.3
   float far_plane = 1000.0f;       // [world units], finite and > near_plane; Unity default 1000
   bool reversed_z = false;         // depth 1 at near, 0 at far (D3D11+/Metal/Vulkan Unity)
+  // Reversed Z with the far plane at infinity (needs reversed_z; far_plane is then ignored):
+  // raw depth = near / eye depth, 0 is infinitely far. A variant of its own (Projection).
+  bool infinite_far = false;
+};
+
+// An orthographic camera (Unity's Camera.orthographic). Depth is linear in eye depth.
+struct OrthographicCamera {
+  float ortho_size = 5.0f;         // Unity's orthographicSize: half the vertical extent [world units], > 0
+  float aspect = 16.0f / 9.0f;     // width / height, finite and > 0
+  float near_plane = 0.3f;         // [world units], finite and >= 0
+  float far_plane = 1000.0f;       // [world units], finite and > near_plane
+  bool reversed_z = false;         // depth 1 at near, 0 at far
+};
+
+// How raw depth maps to distance; each is its own kernel variant (DESIGN.md §2 last paragraph).
+enum class Projection {
+  perspective,               // Linear01Depth = 1 / (x * raw + y)
+  perspective_infinite_far,  // reversed Z, far at infinity: eye depth = near / raw; raw 0 is sky
+  orthographic,              // Linear01Depth = x * raw + y (linear); rays are parallel
 };
 
 // Corner order used by fogcl: bottom-left, bottom-right, top-left, top-right (index u + 2v).
 enum Corner { kBottomLeft = 0, kBottomRight = 1, kTopLeft = 2, kTopRight = 3 };
 
 struct CameraParams {
-  // _ZBufferParams. Conventional Z: (1 - f/n, f/n, x/f, y/f); reversed Z: (-1 + f/n, 1, x/f, 1/f).
+  // _ZBufferParams. Perspective, conventional Z: (1 - f/n, f/n, x/f, y/f); reversed Z:
+  // (-1 + f/n, 1, x/f, 1/f). Orthographic: Linear01Depth = x * raw + y, conventional
+  // ((f - n)/f, n/f, ., .), reversed (-(f - n)/f, 1, ., .); z, w give eye depth the same way.
+  // Infinite far: (0, 0, 1/n, 0) (Linear01Depth does not exist; the kernel uses near / raw).
   glm::vec4 zbuffer_params{0.0f};
-  // _ProjectionParams: (1, near, far, 1/far). x = -1 would mean a flipped projection (unused).
+  // _ProjectionParams: (1, near, far, 1/far); infinite far: (1, near, +inf, 0).
   glm::vec4 projection_params{0.0f};
-  // Far-plane corner rays in view space (z = far), in Corner order.
+  // Corner rays in view space, in Corner order: perspective at z = far; infinite far normalised
+  // to z = 1; orthographic the corners of the far-plane rectangle (rays are parallel to +z).
   std::array<glm::vec3, 4> frustum_corners{};
   bool reversed_z = false;
+  Projection projection = Projection::perspective;
 
   float near_plane() const { return projection_params.y; }
   float far_plane() const { return projection_params.z; }
@@ -38,9 +62,11 @@ struct CameraParams {
 
 // Throws fogcl::Error naming the value and the rule for an invalid camera.
 void validate(const PerspectiveCamera& camera);
+void validate(const OrthographicCamera& camera);
 
 // The constants exactly as Unity computes them (float arithmetic for _ZBufferParams).
 CameraParams make_camera_params(const PerspectiveCamera& camera);
+CameraParams make_camera_params(const OrthographicCamera& camera);
 
 // How a projection matrix maps view depth to clip-space z: OpenGL / GLM default (-1..1) or
 // D3D / Vulkan / GLM_FORCE_DEPTH_ZERO_TO_ONE (0..1). The depth buffer holds [0, 1] either way.

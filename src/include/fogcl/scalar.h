@@ -19,12 +19,15 @@ void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage&
                       const CameraParams& camera, const FogSettings& settings);
 
 // The fog evaluated in T (float or double), unrounded to the storage format: rgba has
-// 4 * width * height values, factor (if asked) width * height fog factors f.
+// 4 * width * height values; factor the fog factors f and amount the fog amounts 1 - f
+// (computed with expm1 for exp/exp2, so a thin fog's amount keeps its relative precision even
+// where f rounds to 1), width * height each.
 template <class T>
 struct FogResult {
   int width = 0, height = 0;
   std::vector<T> rgba;
   std::vector<T> factor;
+  std::vector<T> amount;
 };
 
 template <class T>

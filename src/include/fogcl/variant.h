@@ -24,13 +24,15 @@ struct Variant {
   bool distance = false;    // FOG_DISTANCE
   bool fog_skybox = false;  // FOG_SKYBOX (no sky test)
   bool reversed_z = false;  // REVERSED_Z
+  Projection projection = Projection::perspective;  // FOG_PROJECTION (1 infinite far, 2 orthographic)
   ColorFormat storage = ColorFormat::rgba32f;  // FOG_COLOR_HALF
   Precision precision = Precision::precise;    // FOG_NATIVE_MATH + -cl-fast-relaxed-math
 
   bool needs_pass() const { return mode != KernelMode::none; }
   bool operator==(const Variant& o) const {
     return mode == o.mode && distance == o.distance && fog_skybox == o.fog_skybox &&
-           reversed_z == o.reversed_z && storage == o.storage && precision == o.precision;
+           reversed_z == o.reversed_z && projection == o.projection && storage == o.storage &&
+           precision == o.precision;
   }
 };
 
