@@ -26,6 +26,23 @@ int lines_per_chunk(int compression) {
   }
 }
 
+// Value sizes of the fixed-size attribute types (OpenEXR file layout, "Attribute types"). OpenEXR
+// 3.1 reads that many bytes whatever size the file states, so a different stated size means the
+// two walks would part ways: such a file is corrupt.
+int fixed_size(const std::string& type) {
+  static const struct {
+    const char* type;
+    int size;
+  } sizes[] = {{"box2i", 16},    {"box2f", 16},   {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},
+               {"deepImageState", 1}, {"float", 4}, {"int", 4},        {"double", 8},    {"rational", 8},
+               {"timecode", 8},  {"v2i", 8},      {"v2f", 8},         {"v2d", 16},      {"v3i", 12},
+               {"v3f", 12},      {"v3d", 24},     {"m33f", 36},       {"m33d", 72},     {"m44f", 64},
+               {"m44d", 128},    {"tiledesc", 9}, {"chromaticities", 32}, {"keycode", 28}};
+  for (const auto& s : sizes)
+    if (type == s.type) return s.size;
+  return -1;
+}
+
 }  // namespace
 
 void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::int64_t max_pixels,
@@ -68,6 +85,34 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
       const std::int32_t size = le32(size_bytes);
       if (size < 0 || std::uint64_t(size) > file_size - pos)
         throw fail("attribute '" + attr + "' claims " + std::to_string(size) + " bytes, more than the rest of the file");
+      const int fixed = fixed_size(type);
+      if (fixed >= 0 && size != fixed)
+        throw fail("attribute '" + attr + "' of type " + type + " states " + std::to_string(size) +
+                   " bytes instead of " + std::to_string(fixed));
+      if (type == "chlist") {
+        // OpenEXR reads a channel list up to its empty name, whatever the stated size says, and
+        // goes on from there: follow it the same way so both walks stay in step.
+        std::string channel;
+        char fields[16];
+        for (;;) {
+          read_name(channel);
+          if (channel.empty()) break;
+          get(16, fields);
+        }
+        continue;
+      }
+      if (type == "preview") {
+        // width, height, then width * height RGBA bytes, allocated from the stated width x height.
+        char wh[8];
+        if (size < 8) throw fail("preview attribute of " + std::to_string(size) + " bytes");
+        get(8, wh);
+        const std::uint64_t pw = std::uint32_t(le32(wh)), ph = std::uint32_t(le32(wh + 4));
+        if ((ph != 0 && pw > (std::uint64_t(size) - 8) / ph) || pw * ph * 4 != std::uint64_t(size) - 8)
+          throw fail("preview attribute of " + std::to_string(pw) + "x" + std::to_string(ph) +
+                     " pixels does not match its size of " + std::to_string(size) + " bytes");
+        pos += std::uint64_t(size) - 8;
+        continue;
+      }
       std::vector<char> value;
       const bool wanted = (type == "box2i" && size == 16) || (type == "compression" && size == 1) ||
                           (type == "tiledesc" && size == 9) || (attr == "chunkCount" && size == 4) ||
@@ -89,6 +134,10 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
         compression = std::uint8_t(value[0]);
       } else if (type == "tiledesc" && size == 9) {
         tile_w = le32(&value[0]), tile_h = le32(&value[4]);
+        // OpenEXR sizes its tile buffers from these before reading a tile.
+        if (tile_w < 1 || tile_h < 1 || std::int64_t(tile_w) * tile_h > max_pixels)
+          throw fail("tiles of " + std::to_string(tile_w) + "x" + std::to_string(tile_h) +
+                     " pixels (at least 1x1, at most the pixel limit)");
       } else if (attr == "chunkCount" && size == 4) {
         chunk_count = le32(&value[0]);
       } else if (attr == "type" && size < 64) {

@@ -427,7 +427,9 @@ ExrInput read_exr_memory(const void* data, std::size_t size, const std::string& 
   return read_with(name, request, [&](Source& s) {
     const char* bytes = static_cast<const char*>(data);
     detail::precheck_exr_header(name, size, request.max_pixels,
-                                [&](std::uint64_t offset, std::size_t n, char* dst) { std::memcpy(dst, bytes + offset, n); });
+                                [&](std::uint64_t offset, std::size_t n, char* dst) {
+                                  if (n > 0) std::memcpy(dst, bytes + offset, n);
+                                });
     s.stream = std::make_unique<detail::MemoryIStream>(bytes, size, name);
     s.file = std::make_unique<Imf::MultiPartInputFile>(*s.stream);
   });
