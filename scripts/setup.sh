@@ -7,6 +7,14 @@ packages=(
   libglm-dev libopenexr-dev libpng-dev libcli11-dev
   libgtest-dev libbenchmark-dev
 )
+# --sanitizers: also clang and its runtimes (libFuzzer, ASan, UBSan) for `make asan-test` / `make fuzz`.
+if [ "${1:-}" = "--sanitizers" ]; then
+  packages+=(clang-14 libclang-rt-14-dev)
+fi
+# --bench: also matplotlib, which bench/plot.py draws the throughput plot with.
+if [ "${1:-}" = "--bench" ]; then
+  packages+=(python3-matplotlib)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -118,7 +118,8 @@ TEST_F(Cli, HelpDocumentsEveryFlag) {
   EXPECT_EQ(r.exit_code, 0);
   for (const char* flag : {"--color", "--depth", "--out", "--near", "--far", "--fov", "--aspect", "--reversed-z",
                            "--mode", "--start", "--end", "--density", "--fog-color", "--distance",
-                           "--fog-skybox", "--device"})
+                           "--fog-skybox", "--device", "--layer", "--depth-channel", "--depth-kind", "--rgba-only",
+                           "--png", "--frames", "--keep-going"})
     EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
   const CliRun d = run_cli("demo --help");
   for (const char* flag : {"--out", "--width", "--height", "--device"})

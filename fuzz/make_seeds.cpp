@@ -1,0 +1,38 @@
+// Writes the fuzz target's seed corpus: small files of every kind fogcl reads (tests/exr_fixtures.h),
+// so the fuzzer starts from valid multi-part, tiled, layered, windowed, deep, half and float files.
+// Usage: fogcl_make_seeds DIR
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "exr_fixtures.h"
+
+int main(int argc, char** argv) {
+  using namespace fogcl::fixtures;
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
+    return 2;
+  }
+  const std::string dir = argv[1];
+  std::filesystem::create_directories(dir);
+  const auto box = [](int x0, int y0, int x1, int y1) { return Imath::Box2i(Imath::V2i(x0, y0), Imath::V2i(x1, y1)); };
+  const RenderFrame f = make_render_frame(box(0, 0, 7, 5), box(0, 0, 7, 5), 1);
+  const RenderFrame w = make_render_frame(box(-2, -1, 9, 6), box(1, 0, 6, 4), 2);
+  const auto rgbz = [](const RenderFrame& fr, const std::string& prefix, Imf::PixelType t) {
+    std::vector<Channel> c = color_channels(fr, prefix, t);
+    c.push_back(depth_channel(fr, "Z"));
+    return c;
+  };
+  write_flat(dir + "/half_rgbaz.exr", f, {{"", rgbz(f, "", Imf::HALF), false, false}});
+  write_flat(dir + "/float_tiled_camera.exr", f, {{"", rgbz(f, "", Imf::FLOAT), true, true}});
+  write_flat(dir + "/multipart.exr", f,
+             {{"rgba", color_channels(f, "", Imf::HALF), true, false}, {"depth", {depth_channel(f, "Z")}, false, true}});
+  write_flat(dir + "/layered.exr", f, {{"", rgbz(f, "beauty.", Imf::FLOAT), false, false}});
+  write_flat(dir + "/window.exr", w, {{"", rgbz(w, "", Imf::HALF), false, false}});
+  write_flat(dir + "/depth_only.exr", f, {{"", {depth_channel(f, "depth")}, false, false}});
+  std::vector<float> flat, nearest;
+  write_deep(dir + "/deep.exr", f, &flat, &nearest);
+  std::printf("wrote 7 seed files to %s\n", dir.c_str());
+  return 0;
+}
