@@ -61,11 +61,14 @@ FOG_FN FOG_REAL FOG_NAME(fog_sanitize_depth)(FOG_REAL raw, int reversed_z) {
                     : fmax(fmin(raw, (FOG_REAL)1), (FOG_REAL)0);
 }
 
-/* Linear01Depth = 1 / (x * raw + y). The fma matters: with conventional Z, x * raw and y nearly
- * cancel for far pixels (|x| = far/near), and rounding the product first costs up to
- * far/near ulps; the fused form has a single rounding. */
-FOG_FN FOG_REAL FOG_NAME(fog_linear01_depth)(FOG_REAL raw, FOG_REAL zx, FOG_REAL zy) {
-  return (FOG_REAL)1 / fma(zx, raw, zy);
+/* Linear01Depth = 1 / (x * raw + y), evaluated without cancellation. Conventional Z has
+ * x = 1 - y, so x * raw + y = y * (1 - raw) + raw: two non-negative terms and one rounding in the
+ * fma (1 - raw is exact for raw >= 0.5). The textbook form cancels for far pixels (x * raw ~ -y,
+ * costing up to far/near ulps) and breaks outright once far/near >= 2^24, where float x = 1 - y
+ * has lost its 1 and x + y = 0. Reversed Z (y = 1, x = far/near - 1 > 0) adds two positive
+ * terms already. */
+FOG_FN FOG_REAL FOG_NAME(fog_linear01_depth)(FOG_REAL raw, FOG_REAL zx, FOG_REAL zy, int reversed_z) {
+  return (FOG_REAL)1 / (reversed_z ? fma(zx, raw, zy) : fma(zy, (FOG_REAL)1 - raw, raw));
 }
 
 /* Orthographic depth is linear: Linear01Depth = x * raw + y (lerp(near, far, raw) / far). */
@@ -131,7 +134,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray_length, i
   }
   FOG_REAL linear01 = projection == FOG_PROJECTION_ORTHOGRAPHIC
                           ? FOG_NAME(fog_linear01_depth_ortho)(depth, zx, zy)
-                          : FOG_NAME(fog_linear01_depth)(depth, zx, zy);
+                          : FOG_NAME(fog_linear01_depth)(depth, zx, zy, reversed_z);
   *sky = FOG_NAME(fog_is_sky)(linear01);
   return distance ? linear01 * ray_length
                   : FOG_NAME(fog_depth_distance)(linear01, near_plane, far_plane);

@@ -69,8 +69,8 @@ CameraParams make_camera_params(const PerspectiveCamera& c) {
     corners(1.0);
     return p;
   }
-  // UnityShaderVariables / Camera.cpp: float arithmetic, so x = 1 - y holds exactly and
-  // Linear01Depth(1) == 1 for conventional Z.
+  // UnityShaderVariables / Camera.cpp: float arithmetic, as Unity does (x loses its 1 once
+  // far/near >= 2^24; the kernel does not depend on x for conventional Z).
   if (c.reversed_z) {
     const float x = -1.0f + f / n;
     p.zbuffer_params = glm::vec4(x, 1.0f, x / f, 1.0f / f);
@@ -171,12 +171,15 @@ void validate(const CameraParams& p) {
     if (!std::isfinite(p.zbuffer_params[c]))
       throw Error("camera params: _ZBufferParams component " + std::to_string(c) + " is not finite (got " +
                   str(p.zbuffer_params[c]) + ")");
-  // Linear01Depth must be positive over the whole depth range [0, 1]: x*0 + y > 0 and x*1 + y > 0
-  // (perspective) or >= 0 (orthographic, whose near plane may be at 0).
+  // Linear01Depth must be positive over the whole depth range [0, 1]. Perspective, conventional:
+  // y = far/near >= 1 (x is not used: fog_math.h evaluates y (1 - raw) + raw); reversed: y > 0 and
+  // x + y > 0. Orthographic: x * raw + y >= 0 (its near plane may be at 0).
   const float zx = p.zbuffer_params.x, zy = p.zbuffer_params.y;
-  if (p.projection == Projection::orthographic ? !(zy >= 0.0f && zx + zy >= 0.0f)
-      : p.projection == Projection::perspective ? !(zy > 0.0f && zx + zy > 0.0f)
-                                                : !(p.zbuffer_params.z > 0.0f))
+  const bool ok = p.projection == Projection::orthographic ? zy >= 0.0f && zx + zy >= 0.0f
+                  : p.projection == Projection::perspective_infinite_far ? p.zbuffer_params.z > 0.0f
+                  : p.reversed_z ? zy > 0.0f && zx + zy > 0.0f
+                                 : zy >= 1.0f;
+  if (!ok)
     throw Error("camera params: _ZBufferParams (" + str(zx) + ", " + str(zy) +
                 ") do not describe a perspective depth range (need y > 0 and x + y > 0)");
   for (const glm::vec3& c : p.frustum_corners)

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include <CL/opencl.hpp>
+#include "fogcl/cl.h"
 
 #include "fogcl/camera.h"
 #include "fogcl/fog_settings.h"

@@ -3,6 +3,7 @@
 
 #include "fogcl/camera.h"
 #include "fogcl/error.h"
+#include "fogcl/cl.h"
 #include "fogcl/fog_pass.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"

@@ -8,7 +8,7 @@
 #include <string>
 #include <tuple>
 
-#include <CL/opencl.hpp>
+#include "fogcl/cl.h"
 
 namespace fogcl {
 
