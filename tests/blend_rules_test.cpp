@@ -18,10 +18,11 @@ constexpr float kMax = std::numeric_limits<float>::max();
 struct Path {
   bool scalar;
   ColorFormat format;
+  Precision precision = Precision::precise;
 };
 
 void PrintTo(const Path& p, std::ostream* os) {
-  *os << (p.scalar ? "scalar " : "kernel ") << to_string(p.format);
+  *os << (p.scalar ? "scalar " : "kernel ") << to_string(p.format) << " " << to_string(p.precision);
 }
 
 class BlendRules : public ::testing::TestWithParam<Path> {
@@ -29,7 +30,10 @@ class BlendRules : public ::testing::TestWithParam<Path> {
   void SetUp() override {
     if (!GetParam().scalar && runtime() == nullptr) GTEST_SKIP() << "no OpenCL device: " << runtime_error();
   }
-  ColorImage run(const ColorImage& in, const DepthImage& depth, const CameraParams& cam, const FogSettings& s) {
+  // The fast variants (-cl-fast-relaxed-math implies -cl-finite-math-only, which lets the
+  // compiler assume no NaN/Inf) must keep the same rules: the blend decides on f only.
+  ColorImage run(const ColorImage& in, const DepthImage& depth, const CameraParams& cam, FogSettings s) {
+    s.precision = GetParam().precision;
     ColorImage out;
     if (GetParam().scalar)
       apply_fog_scalar(in, depth, out, cam, s);
@@ -187,9 +191,12 @@ TEST_P(BlendRules, OffAndZeroDensityCopyBitForBit) {
 
 INSTANTIATE_TEST_SUITE_P(Paths, BlendRules,
                          ::testing::Values(Path{false, ColorFormat::rgba32f}, Path{false, ColorFormat::rgba16f},
-                                           Path{true, ColorFormat::rgba32f}, Path{true, ColorFormat::rgba16f}),
+                                           Path{true, ColorFormat::rgba32f}, Path{true, ColorFormat::rgba16f},
+                                           Path{false, ColorFormat::rgba32f, Precision::fast},
+                                           Path{false, ColorFormat::rgba16f, Precision::fast}),
                          [](const auto& info) {
-                           return std::string(info.param.scalar ? "scalar_" : "kernel_") + to_string(info.param.format);
+                           return std::string(info.param.scalar ? "scalar_" : "kernel_") + to_string(info.param.format) +
+                                  "_" + to_string(info.param.precision);
                          });
 
 }  // namespace
