@@ -12,6 +12,7 @@
 #include "cli/sequence.h"
 #include "fogcl/depth_kinds.h"
 #include "fogcl/exr_io.h"
+#include "fogcl/report.h"
 
 namespace fogcl::cli {
 
@@ -27,6 +28,7 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
   camera.near_plane = o.near_plane;
   camera.far_plane = o.far_plane;
   camera.reversed_z = o.reversed_z;
+  camera.infinite_far = o.infinite_far;
   if (o.fov != 0.0f) {
     camera.fov_y_deg = o.fov;
     *from = "flags";
@@ -34,7 +36,7 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
     camera.fov_y_deg = color.camera.fov_y_deg;
     *from = "worldToNDC";
   } else {
-    throw Error(color.path + ": no --fov given and the file has no usable camera (" +
+    throw Error(color.path + ": no --fov (or --ortho-size) given and the file has no usable camera (" +
                 (color.camera.note.empty() ? std::string("no worldToNDC and worldToCamera attributes")
                                            : color.camera.note) +
                 ")");
@@ -46,6 +48,63 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
   else
     camera.aspect = float(color.color.width()) / float(color.color.height());
   return camera;
+}
+
+// The camera constants of one frame: orthographic with --ortho-size, else perspective (finite or
+// infinite far). *text describes it for --verbose.
+CameraParams frame_params(const ApplyOptions& o, const ExrInput& color, std::string* text) {
+  char buf[256];
+  const char* z = o.infinite_far ? "reversed Z (implied by --infinite-far)" : o.reversed_z ? "reversed Z" : "conventional Z";
+  if (o.ortho_size > 0.0f) {
+    OrthographicCamera camera;
+    camera.ortho_size = o.ortho_size;
+    camera.aspect = o.aspect != 0.0f ? o.aspect : float(color.color.width()) / float(color.color.height());
+    camera.near_plane = o.near_plane;
+    camera.far_plane = o.far_plane;
+    camera.reversed_z = o.reversed_z;
+    std::snprintf(buf, sizeof buf, "orthographic, size %g (half height), aspect %g, near %g, far %g, %s",
+                  camera.ortho_size, camera.aspect, camera.near_plane, camera.far_plane, z);
+    *text = buf;
+    return make_camera_params(camera);
+  }
+  std::string from;
+  const PerspectiveCamera camera = frame_camera(o, color, &from);
+  if (camera.infinite_far)
+    std::snprintf(buf, sizeof buf, "perspective, fov %g deg, aspect %g (from %s), near %g, far infinite, %s",
+                  camera.fov_y_deg, camera.aspect, from.c_str(), camera.near_plane, z);
+  else
+    std::snprintf(buf, sizeof buf, "perspective, fov %g deg, aspect %g (from %s), near %g, far %g, %s",
+                  camera.fov_y_deg, camera.aspect, from.c_str(), camera.near_plane, camera.far_plane, z);
+  *text = buf;
+  return make_camera_params(camera);
+}
+
+// The settings of the pass: the precision from --precision, the error budget (--max-error) or
+// the default (precise). *why says which, for --verbose.
+FogSettings pass_settings(const ApplyOptions& o, Backend& backend, ColorFormat storage, std::string* why) {
+  FogSettings s = o.settings;
+  if (!o.max_error_given) {
+    *why = o.precision_given ? "precision: " + std::string(to_string(s.precision)) + " (--precision)\n"
+                             : "precision: precise (the default; no --max-error budget given)\n";
+    return s;
+  }
+  if (backend.is_scalar())
+    throw Error("--max-error picks an OpenCL kernel variant; the scalar path (--device scalar) has none");
+  const PrecisionChoice c = choose_precision_detailed(*backend.runtime(), storage, o.max_error);
+  s.precision = c.precision;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "error budget: --max-error %g, %s storage; measurement %s (%s)\n", o.max_error,
+                to_string(storage), c.from_cache ? "read from the cache" : "taken now and cached", c.measured_on.c_str());
+  *why = buf;
+  *why += "  cache: " + c.cache_file + "\n";
+  for (const VariantMeasurement& m : c.candidates) {
+    std::snprintf(buf, sizeof buf, "  candidate %-8s worst color error %.3g, time %.3f ms over the scenes: %s\n",
+                  to_string(m.precision), m.max_abs_err_color, m.time_ms,
+                  m.max_abs_err_color <= o.max_error ? "meets the budget" : "over the budget");
+    *why += buf;
+  }
+  *why += "precision: " + c.reason + "\n";
+  return s;
 }
 
 void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backend, bool print_setup) {
@@ -60,10 +119,12 @@ void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backen
   if (paths.depth.empty()) request.depth_channel = o.depth_channel;
   ExrInput color = read_exr(paths.color, request);
 
-  std::string camera_from;
-  const PerspectiveCamera camera = frame_camera(o, color, &camera_from);
-  const CameraParams params = make_camera_params(camera);
+  std::string camera_text;
+  const CameraParams params = frame_params(o, color, &camera_text);
   validate(o.settings);
+  if (kind != DepthKind::raw && params.projection != Projection::perspective)
+    throw Error(std::string("--depth-kind ") + to_string(kind) + " needs a perspective camera with a finite far "
+                "plane (give raw depth with --ortho-size or --infinite-far)");
 
   DepthImage depth;
   if (paths.depth.empty()) {
@@ -82,20 +143,34 @@ void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backen
   }
   to_raw_depth(depth, kind, params);
 
+  std::string precision_why;
+  const FogSettings settings = pass_settings(o, backend, color.color.format(), &precision_why);
   if (print_setup) {
-    const Variant variant = select_variant(o.settings, params, color.color.format());
+    const Variant variant = select_variant(settings, params, color.color.format());
     std::fprintf(stderr, "device: %s\n", backend.name().c_str());
-    std::fprintf(stderr, "camera: fov %g deg, aspect %g (from %s), near %g, far %g%s\n", camera.fov_y_deg,
-                 camera.aspect, camera_from.c_str(), camera.near_plane, camera.far_plane,
-                 camera.reversed_z ? ", reversed Z" : "");
+    std::fprintf(stderr, "camera: %s\n", camera_text.c_str());
     std::fprintf(stderr, "depth: %s, channel %s%s\n", to_string(kind), o.depth_channel.c_str(),
                  color.deep ? " (deep color, flattened)" : "");
+    std::fprintf(stderr, "%s", precision_why.c_str());
+    if (backend.is_scalar()) std::fprintf(stderr, "(the scalar path computes in float; it has no precision variants)\n");
     std::fprintf(stderr, "variant: %s\n", describe(variant).c_str());
+    if (variant.needs_pass())
+      std::fprintf(stderr,
+                   "  why: %s fog (--mode), %s, %s, %s projection, %s storage (the input's); what the scene "
+                   "does not use is not compiled\n",
+                   to_string(variant.mode), variant.distance ? "distance-based (--distance)" : "depth-based (no sqrt)",
+                   variant.fog_skybox ? "no sky test (--fog-skybox)" : "sky test (sky stays unfogged)",
+                   params.projection == Projection::orthographic                ? "orthographic (--ortho-size)"
+                   : params.projection == Projection::perspective_infinite_far ? "infinite-far (--infinite-far)"
+                                                                                : "perspective",
+                   to_string(variant.storage));
+    else
+      std::fprintf(stderr, "  why: no pass runs (fog off or density 0): the output is the input\n");
     if (!backend.is_scalar() && variant.needs_pass())
       std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
   }
   ColorImage out;
-  backend.apply(color.color, depth, out, params, o.settings);
+  backend.apply(color.color, depth, out, params, settings);
   write_exr_output(paths.out, out, color, o.rgba_only);
   if (!paths.png.empty()) write_png_preview(paths.png, out);
 }
@@ -104,6 +179,12 @@ void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backen
 
 int run_apply(const ApplyOptions& o) {
   parse_depth_kind(o.depth_kind);  // a bad kind fails before any file is touched
+  if (o.fov != 0.0f && o.ortho_size != 0.0f)
+    throw Error("give either --fov (perspective) or --ortho-size (orthographic), not both");
+  if (o.ortho_size != 0.0f && o.infinite_far)
+    throw Error("--infinite-far is a perspective projection; it does not go with --ortho-size");
+  if (o.max_error_given && o.precision_given)
+    throw Error("give either --precision or --max-error (which picks the precision), not both");
   const FramePattern color = parse_frame_pattern(o.color_path);
   const FramePattern depth = parse_frame_pattern(o.depth_path);
   const FramePattern out = parse_frame_pattern(o.out_path);

@@ -19,6 +19,7 @@ class Backend {
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
              const CameraParams& camera, const FogSettings& settings);
   FogPass* pass() { return pass_.get(); }
+  const Runtime* runtime() const { return runtime_.get(); }  // null for scalar
 
  private:
   std::unique_ptr<Runtime> runtime_;
@@ -45,10 +46,24 @@ struct ApplyOptions {
   std::string frames;              // "FIRST-LAST" for sequences; "" = the frames on disk
   bool keep_going = false;         // sequences: continue past a bad frame
   bool reversed_z = false;
+  float ortho_size = 0;            // > 0: orthographic camera (Unity's orthographicSize), no fov
+  bool infinite_far = false;       // reversed Z with the far plane at infinity (implies reversed_z)
+  bool precision_given = false;    // --precision was on the command line
+  bool max_error_given = false;    // --max-error E picks the precision variant
+  double max_error = 0;            // E, >= 0
   FogSettings settings;
   std::string device;
   bool verbose = false;
 };
 int run_apply(const ApplyOptions& options);
+
+struct ReportCliOptions {
+  std::string out_dir = "fogcl-report";
+  int width = 640;
+  int height = 360;
+  int runs = 9;
+  std::string device;
+};
+int run_report(const ReportCliOptions& options);
 
 }  // namespace fogcl::cli

@@ -1,5 +1,6 @@
 // fogcl: the command-line tool. `fogcl demo` renders and fogs the built-in scene; `fogcl apply`
-// fogs an EXR color + depth pair.
+// fogs an EXR color + depth pair; `fogcl report` measures error against run time per variant.
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <vector>
@@ -64,10 +65,18 @@ int main(int argc, char** argv) {
   apply_cmd->add_flag("--keep-going", ap.keep_going,
                       "Sequences: continue past a bad frame, list the failures at the end (exit code still 1)");
   apply_cmd->add_option("--near", ap.near_plane, "Camera near plane [world units], > 0")->required();
-  apply_cmd->add_option("--far", ap.far_plane, "Camera far plane [world units], > near")->required();
+  apply_cmd->add_option("--far", ap.far_plane,
+                        "Camera far plane [world units], > near; required unless --infinite-far (then it "
+                        "may be given and is ignored)");
   apply_cmd->add_option("--fov", ap.fov,
                         "Vertical field of view [degrees], in (0, 180) (default: from the file's worldToNDC "
-                        "and worldToCamera attributes)");
+                        "and worldToCamera attributes); not with --ortho-size");
+  apply_cmd->add_option("--ortho-size", ap.ortho_size,
+                        "Orthographic camera: Unity's orthographicSize, half the vertical extent of the view "
+                        "volume [world units], > 0; replaces --fov");
+  apply_cmd->add_flag("--infinite-far", ap.infinite_far,
+                      "Reversed Z with the far plane at infinity (raw depth = near / eye depth, 0 is sky); "
+                      "implies --reversed-z; --far is ignored");
   apply_cmd->add_option("--aspect", ap.aspect,
                         "Width / height (default: the file's camera, else the image's display window)");
   apply_cmd->add_flag("--reversed-z", ap.reversed_z, "Depth is reversed Z (1 at near, 0 at far)");
@@ -84,8 +93,25 @@ int main(int argc, char** argv) {
   apply_cmd->add_flag("--fog-skybox", ap.settings.fog_skybox, "Fog the skybox too");
   apply_cmd->add_option("--precision", precision, "Kernel maths: precise (default) or fast")
       ->transform(CLI::IsMember(kPrecisions, CLI::ignore_case));
+  apply_cmd->add_option("--max-error", ap.max_error,
+                        "Error budget: use the fastest precision variant whose measured worst color error "
+                        "(fogcl report's scenes, this device; measured once, cached under "
+                        "$XDG_CACHE_HOME/fogcl) is <= E; not with --precision");
   apply_cmd->add_option("--device", ap.device, kDeviceHelp);
-  apply_cmd->add_flag("--verbose", ap.verbose, "Print the device and the kernel variant chosen");
+  apply_cmd->add_flag("--verbose", ap.verbose, "Print the device, the kernel variant chosen and why");
+
+  fogcl::cli::ReportCliOptions report;
+  CLI::App* report_cmd = app.add_subcommand(
+      "report",
+      "Error against run time: every precision variant x color storage (and the scalar path) on a set of "
+      "scenes, against the float64 path; writes report.csv, report.json and the Pareto plot report.png");
+  report_cmd->add_option("--out", report.out_dir, "Output folder")->capture_default_str();
+  report_cmd->add_option("--device", report.device, kDeviceHelp);
+  report_cmd->add_option("--width", report.width, "Frame width [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
+  report_cmd->add_option("--height", report.height, "Frame height [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
+  report_cmd->add_option("--runs", report.runs, "Timed runs per row (the median is reported), >= 7")
+      ->check(CLI::Range(7, 1000))
+      ->capture_default_str();
 
   try {
     app.parse(argc, argv);
@@ -95,6 +121,16 @@ int main(int argc, char** argv) {
 
   try {
     if (*demo_cmd) return fogcl::cli::run_demo(demo);
+    if (*report_cmd) return fogcl::cli::run_report(report);
+    ap.precision_given = apply_cmd->count("--precision") > 0;
+    ap.max_error_given = apply_cmd->count("--max-error") > 0;
+    if (apply_cmd->count("--far") == 0 && !ap.infinite_far)
+      throw fogcl::Error("--far is required (except with --infinite-far)");
+    if (apply_cmd->count("--ortho-size") > 0 && !(ap.ortho_size > 0.0f && std::isfinite(ap.ortho_size)))
+      throw fogcl::Error("--ortho-size must be finite and > 0 (got " + std::to_string(ap.ortho_size) + ")");
+    if (apply_cmd->count("--fov") > 0 && apply_cmd->count("--ortho-size") > 0)
+      throw fogcl::Error("give either --fov (perspective) or --ortho-size (orthographic), not both");
+    if (ap.infinite_far) ap.reversed_z = true;  // an infinite far plane exists only in reversed Z
     ap.settings.mode = kModes.at(mode);
     ap.settings.precision = kPrecisions.at(precision);
     ap.settings.metric = apply_cmd->count("--distance") > 0 ? FogMetric::distance : FogMetric::depth;

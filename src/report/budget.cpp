@@ -1,0 +1,227 @@
+// The error budget (issue 5 §2): the fastest precision variant whose measured worst color error on
+// the report's scenes meets a maximum, measured once per (device, driver, library version) and
+// cached as a small CSV file under $XDG_CACHE_HOME/fogcl.
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "fogcl/error.h"
+#include "fogcl/report.h"
+
+namespace fogcl {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::atomic<std::size_t> g_measurements{0};
+
+struct CacheKey {
+  std::string device, driver, version;
+};
+
+std::string default_cache_dir() {
+  const char* xdg = std::getenv("XDG_CACHE_HOME");
+  if (xdg != nullptr && *xdg == '/') return (fs::path(xdg) / "fogcl").string();
+  const char* home = std::getenv("HOME");
+  if (home != nullptr && *home != '\0') return (fs::path(home) / ".cache" / "fogcl").string();
+  return (fs::temp_directory_path() / "fogcl-cache").string();
+}
+
+std::string hex64(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+// FNV-1a 64 of the key: a stable file name per (device, driver, version).
+std::string cache_file_name(const CacheKey& k) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const std::string* s : {&k.device, &k.driver, &k.version}) {
+    for (unsigned char c : *s) h = (h ^ c) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;  // separator
+  }
+  return "error-budget-" + hex64(h) + ".csv";
+}
+
+std::string one_line(std::string s) {
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  std::replace(s.begin(), s.end(), '\r', ' ');
+  return s;
+}
+
+bool parse_precision(const std::string& s, Precision* p) {
+  for (Precision q : {Precision::precise, Precision::fast})
+    if (s == to_string(q)) return *p = q, true;
+  return false;
+}
+bool parse_storage(const std::string& s, ColorFormat* f) {
+  for (ColorFormat q : {ColorFormat::rgba32f, ColorFormat::rgba16f})
+    if (s == to_string(q)) return *f = q, true;
+  return false;
+}
+
+struct Cached {
+  std::string measured_on;
+  std::vector<VariantMeasurement> all;
+};
+
+// Reads a cache file; false when missing, unreadable, for another key or malformed (then the
+// measurement is taken again and the file rewritten).
+bool read_cache(const std::string& path, const CacheKey& key, Cached* out) {
+  std::ifstream f(path);
+  if (!f) return false;
+  std::map<std::string, std::string> meta;
+  std::string line;
+  bool table = false;
+  while (std::getline(f, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (!table) {
+      if (line == "precision,storage,max_abs_err_color,time_ms") {
+        table = true;
+        continue;
+      }
+      const std::size_t comma = line.find(',');
+      if (comma == std::string::npos) return false;
+      meta[line.substr(0, comma)] = line.substr(comma + 1);
+      continue;
+    }
+    std::istringstream row(line);
+    std::string p, s, e, t;
+    if (!std::getline(row, p, ',') || !std::getline(row, s, ',') || !std::getline(row, e, ',') ||
+        !std::getline(row, t))
+      return false;
+    VariantMeasurement m;
+    if (!parse_precision(p, &m.precision) || !parse_storage(s, &m.storage)) return false;
+    char* end = nullptr;
+    m.max_abs_err_color = std::strtod(e.c_str(), &end);
+    if (end == e.c_str()) return false;
+    m.time_ms = std::strtod(t.c_str(), &end);
+    if (end == t.c_str()) return false;
+    out->all.push_back(m);
+  }
+  if (meta["device"] != one_line(key.device) || meta["driver"] != one_line(key.driver) ||
+      meta["version"] != key.version)
+    return false;
+  out->measured_on = meta["measured"];
+  return out->all.size() == 4;  // {precise, fast} x {rgba32f, rgba16f}
+}
+
+void write_cache(const std::string& path, const CacheKey& key, const Cached& c) {
+  std::ostringstream s;
+  s << "# fogcl error-budget measurement (fogcl report's scenes); delete this file to measure again\n"
+    << "device," << one_line(key.device) << "\ndriver," << one_line(key.driver) << "\nversion," << key.version
+    << "\nmeasured," << c.measured_on << "\nprecision,storage,max_abs_err_color,time_ms\n";
+  char buf[64];
+  for (const VariantMeasurement& m : c.all) {
+    std::snprintf(buf, sizeof buf, "%.17g,%.17g", m.max_abs_err_color, m.time_ms);
+    s << to_string(m.precision) << ',' << to_string(m.storage) << ',' << buf << '\n';
+  }
+  fs::create_directories(fs::path(path).parent_path());
+  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  {
+    std::ofstream f(tmp, std::ios::trunc);
+    f << s.str();
+    if (!f.flush()) throw Error("cannot write the error-budget cache " + path);
+  }
+  fs::rename(tmp, path);  // atomic: a concurrent reader sees the old file or the new one
+}
+
+Cached measure(const Runtime& runtime, const ReportOptions& options) {
+  ReportOptions o = options;
+  o.scalar = false;
+  const Report report = run_report(&runtime, o);
+  ++g_measurements;
+  Cached c;
+  c.measured_on = std::to_string(o.width) + "x" + std::to_string(o.height) + ", median of " +
+                  std::to_string(o.runs) + " runs";
+  for (ColorFormat storage : {ColorFormat::rgba32f, ColorFormat::rgba16f})
+    for (Precision p : {Precision::precise, Precision::fast}) {
+      VariantMeasurement m;
+      m.precision = p;
+      m.storage = storage;
+      for (const ReportRow& row : report.rows)
+        if (!row.scalar && row.precision == p && row.storage == storage) {
+          // NaN (a non-finite error) must never pass a budget.
+          const double e = std::isnan(row.max_abs_err_color) ? INFINITY : row.max_abs_err_color;
+          m.max_abs_err_color = std::max(m.max_abs_err_color, e);
+          m.time_ms += row.time_ms;
+        }
+      c.all.push_back(m);
+    }
+  return c;
+}
+
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+}  // namespace
+
+std::size_t budget_measurements() { return g_measurements.load(); }
+
+PrecisionChoice choose_precision_detailed(const Runtime& runtime, ColorFormat storage, double max_error,
+                                          const BudgetOptions& options) {
+  if (!(max_error >= 0.0))
+    throw Error("max error must be a number >= 0 (got " + num(max_error) + ")");
+  const CacheKey key = with_cl_errors([&] {
+    const cl::Device& d = runtime.device();
+    const cl::Platform platform(d.getInfo<CL_DEVICE_PLATFORM>());
+    return CacheKey{d.getInfo<CL_DEVICE_NAME>() + " (" + platform.getInfo<CL_PLATFORM_NAME>() + ")",
+                    d.getInfo<CL_DRIVER_VERSION>(), library_version()};
+  });
+  PrecisionChoice choice;
+  choice.max_error = max_error;
+  const std::string dir = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
+  choice.cache_file = (fs::path(dir) / cache_file_name(key)).string();
+
+  Cached cached;
+  if (read_cache(choice.cache_file, key, &cached)) {
+    choice.from_cache = true;
+  } else {
+    cached = measure(runtime, options.measure);
+    try {
+      write_cache(choice.cache_file, key, cached);
+    } catch (const std::exception& e) {  // a read-only cache folder costs a re-measure, no more
+      std::fprintf(stderr, "fogcl: warning: %s\n", e.what());
+    }
+  }
+  choice.measured_on = cached.measured_on;
+  for (const VariantMeasurement& m : cached.all)
+    if (m.storage == storage) choice.candidates.push_back(m);
+  std::sort(choice.candidates.begin(), choice.candidates.end(),
+            [](const VariantMeasurement& a, const VariantMeasurement& b) { return a.time_ms < b.time_ms; });
+
+  const VariantMeasurement* best = nullptr;  // the most accurate, for the error message
+  for (const VariantMeasurement& m : choice.candidates) {
+    if (best == nullptr || m.max_abs_err_color < best->max_abs_err_color) best = &m;
+    if (m.max_abs_err_color <= max_error) {
+      choice.precision = m.precision;
+      choice.reason = std::string(to_string(m.precision)) + " is the fastest variant (" + num(m.time_ms) +
+                      " ms over the report's scenes) whose worst color error " + num(m.max_abs_err_color) +
+                      " is <= the budget " + num(max_error) + " with " + to_string(storage) + " storage";
+      return choice;
+    }
+  }
+  if (best == nullptr) throw Error("error budget: no measurement for " + std::string(to_string(storage)));
+  throw Error("no precision variant meets the error budget (max error " + num(max_error) + ") with " +
+              to_string(storage) + " storage on " + key.device + ": the best achievable worst color error is " +
+              num(best->max_abs_err_color) + " (" + to_string(best->precision) + ")");
+}
+
+Precision choose_precision(const Runtime& runtime, ColorFormat storage, double max_error) {
+  return choose_precision_detailed(runtime, storage, max_error).precision;
+}
+
+}  // namespace fogcl

@@ -1,0 +1,377 @@
+// fogcl report: error against run time for every precision variant and color storage on a set of
+// scenes (DESIGN.md §4). Device time comes from CL profiling events of FogPass::enqueue on
+// zero-copy buffers, as bench/fog_bench.cpp's BM_OpenCLDevice measures it.
+#include "fogcl/report.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <sstream>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "fogcl/camera.h"
+#include "fogcl/demo_scene.h"
+#include "fogcl/error.h"
+#include "fogcl/fog_pass.h"
+#include "fogcl/scalar.h"
+#include "pass/formulas.h"
+#include "report_plot_py.h"  // generated from report/plot_report.py
+
+namespace fogcl {
+
+const char* library_version() { return FOGCL_VERSION; }
+
+namespace {
+
+struct Scene {
+  std::string name;
+  DemoFrame frame;  // rgba32f color, raw depth, camera
+  FogSettings settings;
+  bool eye_depth_check = false;  // the far/near scene: report the eye-depth error
+};
+
+FogSettings fog(FogMode mode, FogMetric metric, float density, bool skybox) {
+  FogSettings s;
+  s.mode = mode;
+  s.metric = metric;
+  s.density = density;
+  s.fog_skybox = skybox;
+  s.color = glm::vec3(0.62f, 0.68f, 0.76f);  // the demo's fog color
+  return s;
+}
+
+// Every scene is the demo scene (analytic, exact depth) seen through a different camera / fog.
+std::vector<Scene> make_scenes(int w, int h) {
+  std::vector<Scene> out;
+  const auto add = [&](const char* name, PerspectiveCamera camera, FogSettings s, bool eye_check = false) {
+    out.push_back({name, render_demo_scene(w, h, camera), s, eye_check});
+  };
+  const PerspectiveCamera standard;  // fov 60, near 0.3, far 1000
+  // The demo: exp2 distance fog as `fogcl demo`'s exp2-distance row.
+  add("demo", standard, fog(FogMode::exp2, FogMetric::distance, 0.025f, false));
+  PerspectiveCamera wide = standard;
+  wide.fov_y_deg = 120.0f;
+  add("wide-fov-120", wide, fog(FogMode::exp, FogMetric::distance, 0.035f, false));
+  PerspectiveCamera huge = standard;
+  huge.near_plane = 0.01f;
+  huge.far_plane = 1e6f;
+  add("near0.01-far1e6-conventional", huge, fog(FogMode::exp, FogMetric::depth, 0.01f, false), true);
+  huge.reversed_z = true;
+  add("near0.01-far1e6-reversed", huge, fog(FogMode::exp, FogMetric::depth, 0.01f, false), true);
+  // density * d up to ~1e3: the fogged sky lies at d = far = 1000.
+  add("dense-exp", standard, fog(FogMode::exp, FogMetric::distance, 1.0f, true));
+  // density * d up to ~1e-4.
+  add("thin-exp2", standard, fog(FogMode::exp2, FogMetric::distance, 1e-7f, true));
+  return out;
+}
+
+// Max relative error of eye depth (Linear01Depth * far) from the float formulas the kernel runs,
+// against the true eye depth whose raw depth (rounded to float, as a depth buffer holds it) they
+// read; eye depths swept geometrically over [2 near, 0.99 far] (tests/extreme_cases_test.cpp).
+double eye_depth_rel_err(const CameraParams& cam) {
+  const double n = cam.near_plane(), f = cam.far_plane();
+  const double zx = cam.zbuffer_params.x, zy = cam.zbuffer_params.y;
+  double worst = 0;
+  for (double eye = 2 * n; eye < 0.99 * f; eye *= 1.37) {
+    const float raw = float((f / eye - zy) / zx);
+    const float l01 = formulas::fog_linear01_depth(raw, cam.zbuffer_params.x, cam.zbuffer_params.y,
+                                                   int(cam.reversed_z));
+    worst = std::max(worst, std::fabs(double(l01) * f - eye) / eye);
+  }
+  return worst;
+}
+
+// One ulp of the storage type at |x|.
+double ulp_at(double x, ColorFormat storage) {
+  x = std::fabs(x);
+  if (storage == ColorFormat::rgba16f)
+    return x < 6.103515625e-05 ? std::ldexp(1.0, -24) : std::ldexp(1.0, int(std::floor(std::log2(x))) - 10);
+  if (x < double(std::numeric_limits<float>::min())) return std::ldexp(1.0, -149);
+  return std::ldexp(1.0, int(std::floor(std::log2(x))) - 23);
+}
+
+// 8-bit sRGB code: NaN -> 0, clamp to [0, 1], IEC 61966-2-1 encode, round; no dither.
+int srgb8(double linear) {
+  const double l = std::isnan(linear) ? 0.0 : std::clamp(linear, 0.0, 1.0);
+  const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+  return int(std::lround(e * 255.0));
+}
+
+std::size_t nonfinite_from_finite(const ColorImage& out, const ColorImage& in) {
+  std::size_t n = 0;
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x) {
+      const glm::vec4 o = out.pixel(x, y), i = in.pixel(x, y);
+      for (int c = 0; c < 4; ++c) n += std::isfinite(i[c]) && !std::isfinite(o[c]);
+    }
+  return n;
+}
+
+// Fills the color error columns of `row` from the output of a run on `in`.
+void color_errors(const ColorImage& out, const ColorImage& in, const FogResult<double>& ref, ReportRow& row) {
+  std::vector<double> errs;
+  errs.reserve(3 * in.pixel_count());
+  std::size_t off = 0;
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(in.width()) + std::size_t(x);
+      const glm::vec4 g = out.pixel(x, y);
+      bool differs = false;
+      for (int c = 0; c < 3; ++c) {
+        const double r = ref.rgba[4 * i + std::size_t(c)];
+        const double e = std::fabs(double(g[c]) - r);
+        errs.push_back(std::isnan(e) ? std::numeric_limits<double>::infinity() : e);
+        row.max_ulp = std::max(row.max_ulp, errs.back() / ulp_at(r, row.storage));
+        differs = differs || srgb8(double(g[c])) != srgb8(r);
+      }
+      off += differs;
+    }
+  row.max_abs_err_color = *std::max_element(errs.begin(), errs.end());
+  const std::size_t k = std::min(errs.size() - 1, std::size_t(std::ceil(0.999 * double(errs.size()))) - 1);
+  std::nth_element(errs.begin(), errs.begin() + std::ptrdiff_t(k), errs.end());
+  row.p999_abs_err_color = errs[k];
+  row.pct_8bit_off = 100.0 * double(off) / double(in.pixel_count());
+  row.nonfinite += nonfinite_from_finite(out, in);
+}
+
+double factor_error(const ColorImage& probe, const FogResult<double>& ref) {
+  double worst = 0;
+  for (int y = 0; y < probe.height(); ++y)
+    for (int x = 0; x < probe.width(); ++x) {
+      const double f = ref.factor[std::size_t(y) * std::size_t(probe.width()) + std::size_t(x)];
+      const glm::vec4 p = probe.pixel(x, y);
+      for (int c = 0; c < 3; ++c) {
+        const double e = std::fabs(double(p[c]) - f);
+        worst = std::max(worst, std::isnan(e) ? std::numeric_limits<double>::infinity() : e);
+      }
+    }
+  return worst;
+}
+
+ColorImage white_like(const ColorImage& like) {
+  ColorImage w(like.width(), like.height(), like.format());
+  for (int y = 0; y < like.height(); ++y)
+    for (int x = 0; x < like.width(); ++x) w.set_pixel(x, y, glm::vec4(1.0f));
+  return w;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The pass on the runtime's queue, zero-copy buffers over the images' memory on CPU devices
+// (copied buffers elsewhere). Returns the median device time [ms] of `runs` enqueues after one
+// untimed warm-up (which builds the variant); `out` holds the result.
+double device_run(const Runtime& rt, FogPass& pass, const ColorImage& in, const DepthImage& depth,
+                  ColorImage& out, const CameraParams& params, const FogSettings& s, int runs) {
+  return with_cl_errors([&] {
+    const bool cpu = rt.is_cpu();
+    const cl_mem_flags host = cpu ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
+    out = ColorImage(in.width(), in.height(), in.format());
+    FrameBuffers fb;
+    fb.width = in.width();
+    fb.height = in.height();
+    fb.format = in.format();
+    fb.color_in = cl::Buffer(rt.context(), CL_MEM_READ_ONLY | host, in.size_bytes(), const_cast<void*>(in.data()));
+    fb.depth = cl::Buffer(rt.context(), CL_MEM_READ_ONLY | host, depth.size_bytes(), const_cast<float*>(depth.data()));
+    fb.color_out = cl::Buffer(rt.context(), CL_MEM_READ_WRITE | host, out.size_bytes(), out.data());
+    pass.enqueue(rt.queue(), fb, params, s).wait();
+    std::vector<double> ms;
+    for (int i = 0; i < runs; ++i) {
+      cl::Event e = pass.enqueue(rt.queue(), fb, params, s);
+      e.wait();
+      ms.push_back(double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                          e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6);
+    }
+    if (cpu)  // make the host view of the USE_HOST_PTR output valid (no copy on CPU devices)
+      rt.queue().enqueueUnmapMemObject(fb.color_out,
+                                       rt.queue().enqueueMapBuffer(fb.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes()));
+    else
+      rt.queue().enqueueReadBuffer(fb.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
+    rt.queue().finish();
+    return median(ms);
+  });
+}
+
+double scalar_run(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& params,
+                  const FogSettings& s, int runs) {
+  apply_fog_scalar(in, depth, out, params, s);
+  std::vector<double> ms;
+  for (int i = 0; i < runs; ++i) {
+    const auto a = std::chrono::steady_clock::now();
+    apply_fog_scalar(in, depth, out, params, s);
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+  }
+  return median(ms);
+}
+
+std::string variant_name(bool scalar, Precision p, ColorFormat storage) {
+  return std::string(scalar ? "scalar" : to_string(p)) + "-" + to_string(storage);
+}
+
+// Numbers as text: shortest round-trip-ish (%.6g), "inf"/"nan" spelled for CSV; JSON gets null.
+std::string num(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+std::string json_num(double v) { return std::isfinite(v) ? num(v) : "null"; }
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+    } else out += c;
+  }
+  return out + "\"";
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+    if (!f) throw Error("cannot write " + path);
+    f << text;
+    if (!f.flush()) throw Error("cannot write " + path);
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error("cannot write " + path);
+}
+
+}  // namespace
+
+std::vector<std::string> report_scene_names() {
+  return {"demo",           "wide-fov-120", "near0.01-far1e6-conventional", "near0.01-far1e6-reversed",
+          "dense-exp", "thin-exp2"};
+}
+
+Report run_report(const Runtime* runtime, const ReportOptions& o) {
+  if (o.width < 1 || o.height < 1)
+    throw Error("report frame size must be >= 1x1 (got " + std::to_string(o.width) + "x" + std::to_string(o.height) + ")");
+  if (o.runs < 7) throw Error("report runs must be >= 7 for a median (got " + std::to_string(o.runs) + ")");
+  Report report;
+  report.version = library_version();
+  report.width = o.width;
+  report.height = o.height;
+  report.runs = o.runs;
+  report.device = runtime ? runtime->description() : "scalar";
+  if (runtime) report.driver = with_cl_errors([&] { return runtime->device().getInfo<CL_DRIVER_VERSION>(); });
+
+  std::unique_ptr<FogPass> pass;
+  if (runtime) pass = std::make_unique<FogPass>(*runtime);
+  for (const Scene& scene : make_scenes(o.width, o.height)) {
+    const double eye_err = scene.eye_depth_check ? eye_depth_rel_err(scene.frame.params) : -1.0;
+    FogSettings probe_settings = scene.settings;
+    probe_settings.color = glm::vec3(0.0f);
+    for (ColorFormat storage : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
+      const ColorImage in = convert(scene.frame.color, storage);
+      const ColorImage white = white_like(in);
+      const FogResult<double> ref = fog_scalar<double>(in, scene.frame.depth, scene.frame.params, scene.settings);
+      const FogResult<double> ref_probe =
+          fog_scalar<double>(white, scene.frame.depth, scene.frame.params, probe_settings);
+      std::vector<ReportRow> rows;
+      if (pass) {
+        for (Precision p : {Precision::precise, Precision::fast}) {
+          ReportRow row;
+          row.precision = p;
+          row.storage = storage;
+          FogSettings s = scene.settings, ps = probe_settings;
+          s.precision = ps.precision = p;
+          ColorImage out, probe;
+          row.time_ms = device_run(*runtime, *pass, in, scene.frame.depth, out, scene.frame.params, s, o.runs);
+          device_run(*runtime, *pass, white, scene.frame.depth, probe, scene.frame.params, ps, 0);
+          color_errors(out, in, ref, row);
+          row.max_abs_err_factor = factor_error(probe, ref_probe);
+          row.nonfinite += nonfinite_from_finite(probe, white);
+          rows.push_back(row);
+        }
+      }
+      if (o.scalar && storage == ColorFormat::rgba32f) {
+        ReportRow row;
+        row.scalar = true;
+        row.storage = storage;
+        ColorImage out, probe;
+        row.time_ms = scalar_run(in, scene.frame.depth, out, scene.frame.params, scene.settings, o.runs);
+        apply_fog_scalar(white, scene.frame.depth, probe, scene.frame.params, probe_settings);
+        color_errors(out, in, ref, row);
+        row.max_abs_err_factor = factor_error(probe, ref_probe);
+        row.nonfinite += nonfinite_from_finite(probe, white);
+        rows.push_back(row);
+      }
+      for (ReportRow& row : rows) {
+        row.scene = scene.name;
+        row.variant = variant_name(row.scalar, row.precision, row.storage);
+        row.eye_depth_rel_err = eye_err;
+        report.rows.push_back(row);
+      }
+    }
+  }
+  return report;
+}
+
+void write_report_csv(const Report& r, const std::string& path) {
+  std::ostringstream s;
+  s << "scene,variant,time_ms,max_abs_err_factor,max_abs_err_color,p999_abs_err_color,max_ulp,pct_8bit_off,"
+       "nonfinite,eye_depth_rel_err\n";
+  for (const ReportRow& row : r.rows)
+    s << row.scene << ',' << row.variant << ',' << num(row.time_ms) << ',' << num(row.max_abs_err_factor) << ','
+      << num(row.max_abs_err_color) << ',' << num(row.p999_abs_err_color) << ',' << num(row.max_ulp) << ','
+      << num(row.pct_8bit_off) << ',' << row.nonfinite << ','
+      << (row.eye_depth_rel_err < 0 ? std::string() : num(row.eye_depth_rel_err)) << '\n';
+  write_file(path, s.str());
+}
+
+void write_report_json(const Report& r, const std::string& path) {
+  std::ostringstream s;
+  s << "{\n  \"device\": " << json_string(r.device) << ",\n  \"driver\": " << json_string(r.driver)
+    << ",\n  \"version\": " << json_string(r.version) << ",\n  \"width\": " << r.width
+    << ",\n  \"height\": " << r.height << ",\n  \"runs\": " << r.runs << ",\n  \"rows\": [";
+  for (std::size_t i = 0; i < r.rows.size(); ++i) {
+    const ReportRow& row = r.rows[i];
+    s << (i ? ",\n" : "\n") << "    {\"scene\": " << json_string(row.scene) << ", \"variant\": " << json_string(row.variant)
+      << ", \"time_ms\": " << json_num(row.time_ms) << ", \"max_abs_err_factor\": " << json_num(row.max_abs_err_factor)
+      << ", \"max_abs_err_color\": " << json_num(row.max_abs_err_color)
+      << ", \"p999_abs_err_color\": " << json_num(row.p999_abs_err_color) << ", \"max_ulp\": " << json_num(row.max_ulp)
+      << ", \"pct_8bit_off\": " << json_num(row.pct_8bit_off) << ", \"nonfinite\": " << row.nonfinite
+      << ", \"eye_depth_rel_err\": " << (row.eye_depth_rel_err < 0 ? "null" : json_num(row.eye_depth_rel_err)) << "}";
+  }
+  s << "\n  ]\n}\n";
+  write_file(path, s.str());
+}
+
+void plot_report(const std::string& dir, const std::string& python) {
+  const std::string install = "install python3-matplotlib (apt-get install python3-matplotlib, or scripts/setup.sh --bench)";
+  if (::access(python.c_str(), X_OK) != 0)
+    throw Error("cannot draw report.png: " + python + " is missing; " + install);
+  // The script reads the folder from argv[1]; exit code 3 means "matplotlib missing".
+  std::string quoted = "'";
+  for (char c : dir) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  quoted += "'";
+  const std::string cmd = python + " - " + quoted;
+  FILE* p = ::popen(cmd.c_str(), "w");
+  if (p == nullptr) throw Error("cannot draw report.png: cannot run " + python);
+  const std::size_t n = sizeof(report_plot_py) - 1;
+  const bool sent = std::fwrite(report_plot_py, 1, n, p) == n;
+  const int status = ::pclose(p);
+  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (code == 3) throw Error("cannot draw report.png: matplotlib is missing for " + python + "; " + install);
+  if (!sent || code != 0)
+    throw Error("cannot draw report.png: the plotting script failed (" + python + " exit code " + std::to_string(code) + ")");
+}
+
+}  // namespace fogcl
