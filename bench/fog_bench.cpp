@@ -189,20 +189,20 @@ Runtime* runtime(benchmark::State& state) {
   return rt.get();
 }
 
-FogPass& shared_pass(Runtime& rt) {
-  static FogPass pass(rt);
-  return pass;
+FogPass& shared_pass(Runtime& rt, bool streaming_stores = true) {
+  static FogPass streaming(rt, true), plain(rt, false);
+  return streaming_stores ? streaming : plain;
 }
 
 void BM_OpenCLDevice(benchmark::State& state) {
   Runtime* rt = runtime(state);
   if (rt == nullptr) return;
-  FogPass& pass = shared_pass(*rt);
+  FogPass& pass = shared_pass(*rt, state.range(5) != 0);
   const cl_mem_flags host = rt->is_cpu() ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
   timed_fog(state, [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     // Buffers wrap the same host memory every time (created once per frame and output).
-    static std::map<std::pair<const void*, const void*>, FrameBuffers> buffers;
-    auto key = std::make_pair(f.color.data(), static_cast<const void*>(out.data()));
+    static std::map<std::tuple<const void*, const void*, const FogPass*>, FrameBuffers> buffers;
+    auto key = std::make_tuple(f.color.data(), static_cast<const void*>(out.data()), &pass);
     auto it = buffers.find(key);
     if (it == buffers.end()) {
       FrameBuffers fb;
@@ -318,6 +318,19 @@ void FogArgs(benchmark::internal::Benchmark* b) {
   b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
 }
 
+// As FogArgs, plus nt: streaming stores (the default) on every case, and off for RGBA32F to
+// show what they are worth.
+void DeviceArgs(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"w", "h", "mode", "dist", "f16", "nt"});
+  for (auto [w, h] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}})
+    for (int mode : {0, 1, 2})
+      for (int dist : {0, 1}) {
+        for (int f16 : {0, 1}) b->Args({w, h, mode, dist, f16, 1});
+        b->Args({w, h, mode, dist, 0, 0});
+      }
+  b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
+}
+
 void MemcpyArgs(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h", "threads"});
   for (auto [w, h] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}})
@@ -329,7 +342,7 @@ BENCHMARK(BM_Memcpy)->Apply(MemcpyArgs);
 BENCHMARK(BM_Scalar)->Apply(FogArgs);
 BENCHMARK(BM_OpenMPSimd)->Apply(FogArgs);
 BENCHMARK(BM_OpenMPSimdFastMath)->Apply(FogArgs);
-BENCHMARK(BM_OpenCLDevice)->Apply(FogArgs);
+BENCHMARK(BM_OpenCLDevice)->Apply(DeviceArgs);
 BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
 BENCHMARK(BM_ProgramBuild)->ArgName("cold")->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_FirstDispatch)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);

@@ -30,8 +30,10 @@ FogPass::FogPass(cl::Context context, cl::Device device)
   });
 }
 
-FogPass::FogPass(const Runtime& runtime) : FogPass(runtime.context(), runtime.device()) {
+FogPass::FogPass(const Runtime& runtime, bool streaming_stores)
+    : FogPass(runtime.context(), runtime.device()) {
   queue_ = runtime.queue();
+  traits_.streaming_stores = streaming_stores;
 }
 
 cl::Kernel& FogPass::kernel_for(const Variant& variant) {

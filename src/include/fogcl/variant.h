@@ -43,6 +43,9 @@ Variant select_variant(const FogSettings& settings, const CameraParams& camera, 
 struct DeviceTraits {
   std::string opencl_c_version = "OpenCL C 1.2";  // CL_DEVICE_OPENCL_C_VERSION
   bool cpu = true;                                // CL_DEVICE_TYPE_CPU
+  // CPU devices: write RGBA32F output with non-temporal stores (no read-for-ownership of the
+  // output). On by default; off only to measure what it is worth.
+  bool streaming_stores = true;
 };
 
 // Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
