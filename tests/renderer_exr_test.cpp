@@ -281,7 +281,7 @@ TEST_F(RendererExr, CameraFromTheFileAttributesAndFlagsWin) {
   fixtures::write_flat(bare, f, {{"", channels, false, false}});
   const CliRun r = run_cli("apply --color " + bare + " --device scalar --out " + path("x.exr") + kFog);
   EXPECT_NE(r.exit_code, 0);
-  EXPECT_NE(r.output.find("no --fov given"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("has no usable camera (no worldToNDC and worldToCamera attributes)"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(path("x.exr")));
 }
 
