@@ -52,18 +52,22 @@
 
 #define FOG_REAL float
 #define FOG_INT int
+#define FOG_AS_UINT as_uint
 #define FOG_NAME(name) name
 #include "fog_math.h"
 #undef FOG_REAL
 #undef FOG_INT
+#undef FOG_AS_UINT
 #undef FOG_NAME
 
 #define FOG_REAL float16
 #define FOG_INT int16
+#define FOG_AS_UINT as_uint16
 #define FOG_NAME(name) name##_v
 #include "fog_math.h"
 #undef FOG_REAL
 #undef FOG_INT
+#undef FOG_AS_UINT
 #undef FOG_NAME
 
 #ifdef FOG_COLOR_HALF

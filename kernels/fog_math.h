@@ -5,7 +5,7 @@
  *     exactly like the scalar version);
  *   - C++ (src/pass/scalar_fog.cpp): FOG_FN makes each function a template on FOG_REAL, so the
  *     same text runs in float for the baseline and in double for the reference.
- * The includer defines FOG_INT and FOG_NAME (and FOG_REAL in OpenCL C); this file has no include
+ * The includer defines FOG_INT and FOG_NAME (and FOG_REAL, FOG_AS_UINT in OpenCL C); this file has no include
  * guard on purpose. Only operations that exist in both languages appear: + - * /, fma, exp2,
  * expm1, sqrt, fmin, fmax and ?: (a per-lane select on vectors in OpenCL C).
  * Sources: Unity's UnityCG.cginc (Linear01Depth, UNITY_CALC_FOG_FACTOR_RAW) and Catlike Coding,
@@ -54,11 +54,20 @@ FOG_FN FOG_REAL FOG_NAME(fog_ray_length)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz) 
   return sqrt(rx * rx + ry * ry + rz * rz);
 }
 
-/* Raw depth outside [0, 1] is clamped; NaN becomes the far value (sky). fmin/fmax return the
- * non-NaN operand, so the order of the two calls decides where a NaN lands. */
+/* NaN test that survives -cl-fast-relaxed-math (which may fold x != x away): the bit pattern.
+ * The includer of an OpenCL instance defines FOG_AS_UINT (as_uint, as_uint16). */
+#ifdef __OPENCL_C_VERSION__
+#define FOG_IS_NAN(x) ((FOG_AS_UINT(x) & 0x7fffffffu) > 0x7f800000u)
+#else
+#define FOG_IS_NAN(x) isnan(x)
+#endif
+
+/* Raw depth outside [0, 1] is clamped; NaN becomes the far value (sky). NaN is tested
+ * explicitly: compilers turn fmin/fmax clamps into saturate instructions that send NaN to 0
+ * (NVIDIA does), which would put a NaN pixel at the near plane. */
 FOG_FN FOG_REAL FOG_NAME(fog_sanitize_depth)(FOG_REAL raw, int reversed_z) {
-  return reversed_z ? fmin(fmax(raw, (FOG_REAL)0), (FOG_REAL)1)
-                    : fmax(fmin(raw, (FOG_REAL)1), (FOG_REAL)0);
+  FOG_REAL clamped = fmin(fmax(raw, (FOG_REAL)0), (FOG_REAL)1);
+  return FOG_IS_NAN(raw) ? (FOG_REAL)(reversed_z ? 0.0f : 1.0f) : clamped;
 }
 
 /* Linear01Depth = 1 / (x * raw + y), evaluated without cancellation. Conventional Z has

@@ -356,7 +356,7 @@ TEST_P(Extreme, OddSizes) {
         if (format == ColorFormat::rgba32f)
           EXPECT_LE(e.max_rel, kColorRelBudget) << w << "x" << h;
         else
-          EXPECT_LE(e.max_ulps, 1.0) << w << "x" << h;
+          EXPECT_LE(e.max_half_ulps_beyond_factor, 1.0) << w << "x" << h;
       }
     }
 }

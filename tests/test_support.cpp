@@ -103,6 +103,9 @@ ErrorStats compare_color(const ColorImage& got, const FogResult<double>& ref, co
         s.max_abs = std::max(s.max_abs, err);
         s.max_rel = std::max(s.max_rel, err / scale);
         s.max_ulps = std::max(s.max_ulps, err / half_ulp(r));
+        const double factor_allowance = 2e-6 * std::fabs(double(c[ch]) - double(fog_color[ch]));
+        s.max_half_ulps_beyond_factor =
+            std::max(s.max_half_ulps_beyond_factor, std::max(0.0, err - factor_allowance) / half_ulp(r));
       }
       // Alpha passes through untouched: bit-compare.
       bool alpha_same;

@@ -10,6 +10,7 @@ using std::expm1;
 using std::fma;
 using std::fmax;
 using std::fmin;
+using std::isnan;
 using std::sqrt;
 #define FOG_INT int
 #define FOG_NAME(name) name
