@@ -44,7 +44,7 @@ asan-build:
 # Every test but the 1080p / 8K frame sizes: under ASan they run the same host code as the smaller
 # sizes (the kernel itself runs in PoCL's JIT, which ASan does not instrument) at 3x the time.
 asan-test: asan-build
-	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -E '1920x1080|EightK
+	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -E '1920x1080|EightK'
 
 # Bounded fuzz run (FUZZ_SECONDS) from the generated seed corpus; new inputs go to $(ASAN_BUILD)/fuzz-corpus.
 fuzz: asan-build
