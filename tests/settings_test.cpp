@@ -288,11 +288,11 @@ DeviceTraits dev(const std::string& opencl_c_version) {
 
 TEST(VariantTest, BuildOptionsExactStrings) {
   EXPECT_EQ(build_options(variant(KernelMode::exp2)),
-            "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_VECTOR_WIDTH=16 -D FOG_STREAMING_STORES");
+            "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_VECTOR_WIDTH=16");
   EXPECT_EQ(build_options(variant(KernelMode::exp2, true)),
-            "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE -D FOG_VECTOR_WIDTH=16 -D FOG_STREAMING_STORES");
+            "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE -D FOG_VECTOR_WIDTH=16");
   EXPECT_EQ(build_options(variant(KernelMode::linear, false, true)),
-            "-cl-std=CL1.2 -D FOG_MODE=1 -D FOG_SKYBOX -D FOG_VECTOR_WIDTH=16 -D FOG_STREAMING_STORES");
+            "-cl-std=CL1.2 -D FOG_MODE=1 -D FOG_SKYBOX -D FOG_VECTOR_WIDTH=16");
   EXPECT_EQ(build_options(variant(KernelMode::linear_step, false, false, true, ColorFormat::rgba16f)),
             "-cl-std=CL1.2 -D FOG_MODE=2 -D REVERSED_Z -D FOG_COLOR_HALF -D FOG_VECTOR_WIDTH=16");
   EXPECT_EQ(build_options(variant(KernelMode::exp, true, true, true, ColorFormat::rgba16f, Precision::fast)),

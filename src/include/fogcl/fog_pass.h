@@ -40,7 +40,7 @@ class FogPass {
   // Integration: programs are built for `device` in the caller's `context`.
   FogPass(cl::Context context, cl::Device device);
   // Convenience: the runtime's context, device and queue. streaming_stores: see DeviceTraits.
-  explicit FogPass(const Runtime& runtime, bool streaming_stores = true);
+  explicit FogPass(const Runtime& runtime, bool streaming_stores = false);
 
   // Enqueues the pass on `queue` (of this pass's context and device) after `wait_list` and
   // returns the event of its last command. Never blocks the host. Fog off (or density 0)
