@@ -10,6 +10,7 @@
 //   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish)
 // Counters: bytes_per_second; vs_memcpy2 = (2-thread memcpy time of the same bytes, measured in this
 // process) / (this time); max_err = max |color - float64 path| (speed always comes with its error).
+// BM_OpticalDepth: exp fog at density * d ~ 1, 1e2 (denormal factors), 1e3, 1e20.
 // Start-up: BM_ProgramBuild (cold: a never-seen option string; warm: PoCL's disk cache),
 // BM_FirstDispatch, BM_DispatchOverhead (1x1 frame), BM_StartToFirstFrame (whole process path:
 // platform, context, build, one 1080p frame; run it in a fresh process with an empty
@@ -242,6 +243,27 @@ void BM_OpenCLHostCall(benchmark::State& state) {
   });
 }
 
+// Optical depth density * d across the frame ~ 10^range(0) at the demo scene's distances: 1 (f in
+// the normal range), 100 (exp(-100) = 4e-44: f is a float denormal), 1e3 and 1e20 (f underflows
+// to 0). Shows whether denormal factors slow the pass down (x86 microcode assists).
+void BM_OpticalDepth(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  FogPass& pass = shared_pass(*rt);
+  const DemoFrame& f = frame(1920, 1080, ColorFormat::rgba32f);
+  FogSettings s;
+  s.mode = FogMode::exp;
+  s.density = float(std::pow(10.0, double(state.range(0))) / 20.0);  // demo distances ~2..70
+  ColorImage out;
+  pass.apply(f.color, f.depth, out, f.params, s);
+  for (auto _ : state) {
+    const auto a = Clock::now();
+    pass.apply(f.color, f.depth, out, f.params, s);
+    state.SetIterationTime(seconds_since(a));
+  }
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(pass_bytes(f)));
+}
+
 Variant bench_variant(ColorFormat format = ColorFormat::rgba32f) {
   FogSettings s;
   s.mode = FogMode::exp2;
@@ -351,6 +373,7 @@ BENCHMARK(BM_OpenMPSimd)->Apply(FogArgs);
 BENCHMARK(BM_OpenMPSimdFastMath)->Apply(FogArgs);
 BENCHMARK(BM_OpenCLDevice)->Apply(DeviceArgs);
 BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
+BENCHMARK(BM_OpticalDepth)->ArgName("log10_density_d")->Arg(0)->Arg(2)->Arg(3)->Arg(20)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ProgramBuild)->ArgName("cold")->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_FirstDispatch)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_DispatchOverhead)->UseManualTime()->Unit(benchmark::kMicrosecond);

@@ -61,7 +61,7 @@ for ax, (dist, f16) in zip(axes.flat, [("0", "0"), ("1", "0"), ("0", "1"), ("1",
         for (w, h) in resolutions:
             key = [b for _, (n, a, b) in rows.items()
                    if n == bench and a.get("w") == str(w) and a.get("h") == str(h) and a.get("mode") == "2"
-                   and a.get("dist") == dist and a.get("f16") == f16]
+                   and a.get("dist") == dist and a.get("f16") == f16 and a.get("nt", "0") == "0"]
             ys.append(gbps(key[0]) if key else 0)
         ax.bar([r + i * width for r in range(len(resolutions))], ys, width, label=label)
     for r, (w, h) in enumerate(resolutions):
@@ -73,18 +73,20 @@ for ax, (dist, f16) in zip(axes.flat, [("0", "0"), ("1", "0"), ("0", "1"), ("1",
     ax.set_title(f"exp2 fog, {'distance' if dist == '1' else 'depth'}-based, {'RGBA16F' if f16 == '1' else 'RGBA32F'}")
     ax.set_ylabel("GB/s moved (color in + out, depth in)")
     ax.set_yscale("log")
-axes.flat[0].legend(fontsize=8)
+axes.flat[0].legend(fontsize=8, loc="lower right")
 fig.suptitle("fogcl throughput per path (higher is better); dashed: 2-thread memcpy of the same bytes")
 fig.tight_layout()
 fig.savefig(out / "throughput.png", dpi=110)
 
 # Table: per resolution / mode / metric / storage: ms and ratio to memcpy2 for each path.
-lines = ["| frame | fog | storage | memcpy 2T ms | scalar ms | OpenMP ms | OpenMP fast-math ms | OpenCL device ms | OpenCL host call ms | OpenCL / memcpy2 | OpenCL vs scalar | max err (OpenCL) |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+lines = ["| frame | fog | storage | memcpy 2T ms | scalar ms | OpenMP ms | OpenMP fast-math ms | OpenCL device ms | OpenCL device, streaming stores ms | OpenCL host call ms | OpenCL / memcpy2 | OpenCL vs scalar | max err (OpenCL) |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 by_case = defaultdict(dict)
 for _, (n, a, b) in rows.items():
     if "mode" in a:
-        by_case[(int(a["w"]), int(a["h"]), a["mode"], a["dist"], a["f16"])][n] = b
+        # nt=1: the same device run with streaming stores (not the default), its own column.
+        name = n + ("-nt" if a.get("nt") == "1" else "")
+        by_case[(int(a["w"]), int(a["h"]), a["mode"], a["dist"], a["f16"])][name] = b
 for (w, h, mode, dist, f16), paths in sorted(by_case.items(), key=lambda kv: (kv[0][0] * kv[0][1], kv[0][2:])):
     def t(name):
         return f"{ms(paths[name]):.2f}" if name in paths else "-"
@@ -96,11 +98,11 @@ for (w, h, mode, dist, f16), paths in sorted(by_case.items(), key=lambda kv: (kv
     m2 = f"{ms(memcpy[(w, h, 2)]):.2f}" if (w, h, 2) in memcpy else "-"
     lines.append(f"| {w}x{h} | {MODES[mode]} {'distance' if dist == '1' else 'depth'} | {'f16' if f16 == '1' else 'f32'} | "
                  f"{m2} | {t('BM_Scalar')} | {t('BM_OpenMPSimd')} | {t('BM_OpenMPSimdFastMath')} | {t('BM_OpenCLDevice')} | "
-                 f"{t('BM_OpenCLHostCall')} | {ratio} | {speedup} | {err} |")
+                 f"{t('BM_OpenCLDevice-nt')} | {t('BM_OpenCLHostCall')} | {ratio} | {speedup} | {err} |")
 
 extra = []
 for _, (n, a, b) in rows.items():
-    if n in ("BM_ProgramBuild", "BM_FirstDispatch", "BM_DispatchOverhead"):
+    if n in ("BM_ProgramBuild", "BM_FirstDispatch", "BM_DispatchOverhead", "BM_OpticalDepth"):
         label = n + ("" if not a else " " + " ".join(f"{k}={v}" for k, v in a.items() if k not in ("iterations", "manual_time")))
         extra.append(f"| {label} | {ms(b):.3f} ms |")
 for name in ("start-cold", "start-warm"):
@@ -110,7 +112,7 @@ for name in ("start-cold", "start-warm"):
             extra.append(f"| process start to first 1080p frame ({name.split('-')[1]} PoCL cache) | {ms(b):.1f} ms |")
 p1 = medians(pocl1)
 for _, (n, a, b) in p1.items():
-    if n == "BM_OpenCLDevice" and a.get("w") == "1920" and a.get("f16") == "0":
+    if n == "BM_OpenCLDevice" and a.get("w") == "1920" and a.get("f16") == "0" and a.get("nt") == "0":
         two = [x for _, (m, aa, x) in rows.items() if m == n and aa == a]
         if two:
             extra.append(f"| PoCL 1 vs 2 threads, 1080p {MODES[a['mode']]} {'distance' if a['dist'] == '1' else 'depth'} | "

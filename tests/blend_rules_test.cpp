@@ -132,8 +132,12 @@ TEST_P(BlendRules, PartialFogKeepsNaNInItsChannelAndFiniteStaysFinite) {
     for (int x = 0; x < in.width(); ++x) {
       const glm::vec4 c = in.pixel(x, y), o = out.pixel(x, y);
       for (int ch = 0; ch < 3; ++ch) {
-        if (std::isnan(c[ch])) EXPECT_TRUE(std::isnan(o[ch])) << x << "," << y << " ch " << ch;
-        if (std::isinf(c[ch]) && GetParam().format == ColorFormat::rgba32f) EXPECT_EQ(o[ch], c[ch]);
+        if (std::isnan(c[ch])) {
+          EXPECT_TRUE(std::isnan(o[ch])) << x << "," << y << " ch " << ch;
+        }
+        if (std::isinf(c[ch]) && GetParam().format == ColorFormat::rgba32f) {
+          EXPECT_EQ(o[ch], c[ch]);
+        }
         // Half storage: a finite value above 65504 rounds to Inf when stored; that is the
         // storage's range, not the blend (the input itself is already Inf there).
         if (std::isfinite(c[ch]) && !std::isfinite(o[ch])) ++nonfinite_from_finite;
@@ -186,7 +190,9 @@ TEST_P(BlendRules, OffAndZeroDensityCopyBitForBit) {
     const ColorImage out = run(in, depth, cam, s);
     ASSERT_EQ(std::memcmp(in.data(), out.data(), in.size_bytes()), 0) << to_string(s.mode);
   }
-  if (!GetParam().scalar) EXPECT_EQ(shared_pass().stats().kernel_dispatches, dispatches) << "fog off dispatched a kernel";
+  if (!GetParam().scalar) {
+    EXPECT_EQ(shared_pass().stats().kernel_dispatches, dispatches) << "fog off dispatched a kernel";
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Paths, BlendRules,

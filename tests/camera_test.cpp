@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include <glm/ext/matrix_clip_space.hpp>
 #include <glm/trigonometric.hpp>
 
@@ -18,6 +20,9 @@
 
 namespace fogcl {
 namespace {
+
+using test::error_of;
+using test::num;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -43,31 +48,7 @@ double rel(double got, double want) {
   return want == 0.0 ? d : d / std::fabs(want);
 }
 
-// The library formats numbers with 9 significant digits.
-std::string num(float v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v;
-  return s.str();
-}
 
-// Runs fn, expects fogcl::Error, returns its message ("" and a failure otherwise).
-template <class Fn>
-std::string error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected fogcl::Error, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected fogcl::Error, nothing was thrown";
-  return {};
-}
-
-#define EXPECT_MSG_HAS(msg, part) \
-  EXPECT_NE((msg).find(part), std::string::npos) << "message: '" << (msg) << "' lacks '" << (part) << "'"
 
 // ---------------------------------------------------------------------------------------------
 // make_camera_params

@@ -15,22 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int exit_code;
-  std::string output;  // stdout + stderr
-};
-
-CliRun run_cli(const std::string& args) {
-  const std::string cmd = std::string(FOGCL_CLI_PATH) + " " + args + " 2>&1";
-  CliRun r{-1, {}};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p) != nullptr) r.output += buf.data();
-  const int status = pclose(p);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
 
 class Cli : public ::testing::Test {
  protected:
@@ -54,7 +38,9 @@ TEST_F(Cli, DemoWritesImagesAndATable) {
                         "exp2-distance-scalar.png"})
     EXPECT_TRUE(fs::exists(in(f))) << f;
   EXPECT_NE(demo_output_.find("median ms"), std::string::npos) << demo_output_;
-  if (runtime() != nullptr) EXPECT_TRUE(fs::exists(in("exp2-distance-opencl.exr")));
+  if (runtime() != nullptr) {
+    EXPECT_TRUE(fs::exists(in("exp2-distance-opencl.exr")));
+  }
 }
 
 TEST_F(Cli, ApplyMatchesTheDoublePath) {

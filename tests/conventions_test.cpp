@@ -64,7 +64,9 @@ TEST_P(Conventions, CornerOrderAndUvOrientation) {
     const std::vector<double> d = measured_distance(depth, cam, FogMetric::distance, GetParam());
     const std::size_t expect = std::size_t(py[corner]) * 2 + px[corner];
     for (std::size_t i = 0; i < 4; ++i)
-      if (i != expect) EXPECT_GT(d[expect], d[i] * 1.5) << "corner " << corner << " pixel " << i;
+      if (i != expect) {
+        EXPECT_GT(d[expect], d[i] * 1.5) << "corner " << corner << " pixel " << i;
+      }
   }
 }
 

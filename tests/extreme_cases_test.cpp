@@ -152,7 +152,9 @@ TEST_P(Extreme, ZeroDensityIsTheIdentityEvenAtInfinity) {
     const ColorImage out = run(scalar(), t.color, t.depth, cam, s);
     EXPECT_EQ(std::memcmp(out.data(), t.color.data(), out.size_bytes()), 0) << to_string(m);
   }
-  if (!scalar()) EXPECT_EQ(shared_pass().stats().kernel_dispatches, dispatches);
+  if (!scalar()) {
+    EXPECT_EQ(shared_pass().stats().kernel_dispatches, dispatches);
+  }
 }
 
 // 3. density * d of 1e3 and 1e20: f is exactly 0 (the fog color), never NaN after squaring.
@@ -240,7 +242,9 @@ TEST_P(Extreme, HugeFarNearRatio) {
     }
     std::printf("[ worst    ] near 0.01 far 1e6 %s: eye depth relative error %.2e (at eye %.3g)\n",
                 reversed ? "reversed Z" : "conventional Z", worst, worst_at);
-    if (reversed) EXPECT_LE(worst, 1e-6);
+    if (reversed) {
+      EXPECT_LE(worst, 1e-6);
+    }
   }
 }
 

@@ -11,28 +11,16 @@
 
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include "fogcl/error.h"
 #include "fogcl/image.h"
 
 namespace fogcl {
 namespace {
 
-template <class Fn>
-std::string error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected fogcl::Error, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected fogcl::Error, nothing was thrown";
-  return {};
-}
+using test::error_of;
 
-#define EXPECT_MSG_HAS(msg, part) \
-  EXPECT_NE((msg).find(part), std::string::npos) << "message: '" << (msg) << "' lacks '" << (part) << "'"
 
 bool aligned(const void* p) { return reinterpret_cast<std::uintptr_t>(p) % 4096 == 0; }
 

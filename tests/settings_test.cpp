@@ -16,32 +16,13 @@
 namespace fogcl {
 namespace {
 
+using test::error_of;
+using test::num;
+
 const float kNaN = std::numeric_limits<float>::quiet_NaN();
 const float kInf = std::numeric_limits<float>::infinity();
 
-std::string num(float v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v;
-  return s.str();
-}
 
-template <class Fn>
-std::string error_of(Fn&& fn) {
-  try {
-    fn();
-  } catch (const Error& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected fogcl::Error, got another exception: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected fogcl::Error, nothing was thrown";
-  return {};
-}
-
-#define EXPECT_MSG_HAS(msg, part) \
-  EXPECT_NE((msg).find(part), std::string::npos) << "message: '" << (msg) << "' lacks '" << (part) << "'"
 
 FogSettings mode(FogMode m) {
   FogSettings s;

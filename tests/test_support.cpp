@@ -1,6 +1,11 @@
 #include "test_support.h"
 
+#include <sys/wait.h>
+
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <sstream>
 #include <filesystem>
 #include <memory>
 #include <random>
@@ -144,6 +149,25 @@ std::string temp_dir() {
     return p.string();
   }();
   return dir;
+}
+
+std::string num(float v) {
+  std::ostringstream s;
+  s.precision(9);
+  s << v;
+  return s.str();
+}
+
+CliRun run_cli(const std::string& args, const std::string& env) {
+  const std::string cmd = env + " " + std::string(FOGCL_CLI_PATH) + " " + args + " 2>&1";
+  CliRun r{-1, {}};
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p) != nullptr) r.output += buf.data();
+  const int status = pclose(p);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
 }
 
 }  // namespace fogcl::test

@@ -68,6 +68,34 @@ double half_ulp(double x);
 
 std::string temp_dir();  // a per-run scratch folder
 
+// Runs fn, expects fogcl::Error, returns its message ("" and a test failure otherwise).
+template <class Fn>
+std::string error_of(Fn&& fn) {
+  try {
+    fn();
+  } catch (const Error& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected fogcl::Error, got another exception: " << e.what();
+    return {};
+  }
+  ADD_FAILURE() << "expected fogcl::Error, nothing was thrown";
+  return {};
+}
+
+#define EXPECT_MSG_HAS(msg, part) \
+  EXPECT_NE((msg).find(part), std::string::npos) << "message: '" << (msg) << "' lacks '" << (part) << "'"
+
+// A float as the library formats it in messages (9 significant digits).
+std::string num(float v);
+
+// The fogcl CLI run with `args` (and `env` assignments before it), stdout + stderr captured.
+struct CliRun {
+  int exit_code;
+  std::string output;
+};
+CliRun run_cli(const std::string& args, const std::string& env = "");
+
 }  // namespace fogcl::test
 
 namespace fogcl {
