@@ -126,7 +126,7 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
       if (type == "box2i" && size == 16) {
         const std::int64_t w = std::int64_t(le32(&value[8])) - le32(&value[0]) + 1;
         const std::int64_t h = std::int64_t(le32(&value[12])) - le32(&value[4]) + 1;
-        if (w > 0 && h > 0 && w * h > max_pixels)
+        if (w > 0 && h > 0 && w > max_pixels / h)  // w * h may not fit in 64 bits (found by the fuzzer)
           throw fail(attr + " is " + std::to_string(w) + "x" + std::to_string(h) + " pixels, more than the limit of " +
                      (max_pixels == (std::int64_t(1) << 31) ? std::string("2^31") : std::to_string(max_pixels)));
         if (attr == "dataWindow") have_data = w > 0 && h > 0, data_w = w, data_h = h;
