@@ -103,15 +103,7 @@ Case case_of(const benchmark::State& s) {
 }
 
 double max_error(const ColorImage& out, const DemoFrame& f, const FogSettings& s) {
-  const FogResult<double> ref = fog_scalar<double>(f.color, f.depth, f.params, s);
-  double worst = 0;
-  for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x) {
-      const glm::vec4 p = out.pixel(x, y);
-      for (int c = 0; c < 3; ++c)
-        worst = std::max(worst, std::fabs(double(p[c]) - ref.rgba[4 * (std::size_t(y) * out.width() + x) + c]));
-    }
-  return worst;
+  return max_abs_rgb_error(out, fog_scalar<double>(f.color, f.depth, f.params, s));
 }
 
 // Per-iteration seconds of the timed loop: manual time if set, else real time.

@@ -136,10 +136,7 @@ double factor_error(const ColorImage& probe, const FogResult<double>& ref) {
 }
 
 ColorImage white_like(const ColorImage& like) {
-  ColorImage w(like.width(), like.height(), like.format());
-  for (int y = 0; y < like.height(); ++y)
-    for (int x = 0; x < like.width(); ++x) w.set_pixel(x, y, glm::vec4(1.0f));
-  return w;
+  return uniform_image(like.width(), like.height(), like.format(), glm::vec4(1.0f));
 }
 
 std::string temp_dir() {

@@ -56,18 +56,6 @@ double median_ms(int runs, Fn&& fn) {
   return t[t.size() / 2];
 }
 
-// Max |out - reference| over RGB.
-double max_error(const ColorImage& out, const FogResult<double>& ref) {
-  double worst = 0;
-  for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x) {
-      const glm::vec4 p = out.pixel(x, y);
-      for (int c = 0; c < 3; ++c)
-        worst = std::max(worst, std::fabs(double(p[c]) - ref.rgba[4 * (std::size_t(y) * out.width() + x) + c]));
-    }
-  return worst;
-}
-
 }  // namespace
 
 int run_demo(const DemoOptions& o) {
@@ -109,7 +97,7 @@ int run_demo(const DemoOptions& o) {
       const int runs = b->is_scalar() ? 3 : 9;
       const double ms = median_ms(runs, [&] { b->apply(frame.color, frame.depth, out, frame.params, d.settings); });
       const char* kind = b->is_scalar() ? "scalar" : "opencl";
-      std::printf("%-22s %-8s %12.3f %14.3g\n", d.name, kind, ms, max_error(out, ref));
+      std::printf("%-22s %-8s %12.3f %14.3g\n", d.name, kind, ms, max_abs_rgb_error(out, ref));
       const std::string stem = std::string(d.name) + "-" + kind;
       write_exr_rgba(path(stem + ".exr"), out);
       write_png_preview(path(stem + ".png"), out);

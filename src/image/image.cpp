@@ -112,6 +112,13 @@ void validate_frame(const ColorImage& color, const DepthImage& depth) {
                 ": they must be the same size");
 }
 
+ColorImage uniform_image(int width, int height, ColorFormat format, const glm::vec4& rgba) {
+  ColorImage image(width, height, format);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) image.set_pixel(x, y, rgba);
+  return image;
+}
+
 ColorImage convert(const ColorImage& image, ColorFormat format) {
   if (image.format() == format) return image;
   ColorImage out(image.width(), image.height(), format);

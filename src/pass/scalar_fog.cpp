@@ -1,5 +1,6 @@
 #include "fogcl/scalar.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -132,6 +133,20 @@ FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const Cam
     for (int c = 0; c < 4; ++c) r.rgba[4 * i + c] = rgba[c];
   });
   return r;
+}
+
+double max_abs_rgb_error(const ColorImage& image, const FogResult<double>& reference) {
+  double worst = 0;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      const glm::vec4 p = image.pixel(x, y);
+      const std::size_t i = 4 * (std::size_t(y) * std::size_t(image.width()) + std::size_t(x));
+      for (int c = 0; c < 3; ++c) {
+        const double e = std::fabs(double(p[c]) - reference.rgba[i + c]);
+        worst = std::max(worst, std::isnan(e) ? INFINITY : e);
+      }
+    }
+  return worst;
 }
 
 template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,

@@ -98,6 +98,10 @@ class DepthImage {
 // Throws fogcl::Error unless color and depth are non-empty and of the same size.
 void validate_frame(const ColorImage& color, const DepthImage& depth);
 
+// A width x height image with every pixel `rgba` (e.g. the white probe that makes a fogged
+// output equal the fog factor).
+ColorImage uniform_image(int width, int height, ColorFormat format, const glm::vec4& rgba);
+
 // Converts a color image to another storage format (round to nearest even for half).
 ColorImage convert(const ColorImage& image, ColorFormat format);
 

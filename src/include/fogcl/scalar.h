@@ -34,6 +34,10 @@ template <class T>
 FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& camera,
                         const FogSettings& settings);
 
+// max over pixels and R, G, B of |image - reference.rgba| (a NaN difference counts as +inf):
+// the "max error against the float64 path" every tool of the project reports.
+double max_abs_rgb_error(const ColorImage& image, const FogResult<double>& reference);
+
 extern template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&,
                                                    const CameraParams&, const FogSettings&);
 extern template FogResult<double> fog_scalar<double>(const ColorImage&, const DepthImage&,
