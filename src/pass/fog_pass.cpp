@@ -37,12 +37,15 @@ FogPass::FogPass(const Runtime& runtime, bool streaming_stores)
 }
 
 cl::Kernel& FogPass::kernel_for(const Variant& variant) {
+  if (last_kernel_ != nullptr && variant == last_kernel_variant_) return *last_kernel_;
   const std::string options = build_options(variant, traits_);
   auto it = kernels_.find(options);
   if (it == kernels_.end()) {
     cl::Program program = programs_.get(device_, "deferred_fog.cl", deferred_fog_cl, options);
     it = kernels_.emplace(options, with_cl_errors([&] { return cl::Kernel(program, "deferred_fog"); })).first;
   }
+  last_kernel_variant_ = variant;
+  last_kernel_ = &it->second;  // std::map nodes do not move
   return it->second;
 }
 

@@ -76,6 +76,9 @@ class FogPass {
   cl::CommandQueue queue_;  // convenience queue; created on first apply() if not given
   DeviceTraits traits_;
   std::map<std::string, cl::Kernel> kernels_;  // by build options
+  // The kernel of the most recent variant: a steady stream of frames skips the option string.
+  Variant last_kernel_variant_;
+  cl::Kernel* last_kernel_ = nullptr;
   PassStats stats_;
   Variant last_variant_;
 };
