@@ -84,11 +84,7 @@ TestFrame make_test_frame(int width, int height, bool reversed_z, ColorFormat fo
   return t;
 }
 
-double half_ulp(double x) {
-  x = std::fabs(x);
-  if (x < 6.103515625e-05) return std::ldexp(1.0, -24);  // subnormal spacing
-  return std::ldexp(1.0, int(std::floor(std::log2(x))) - 10);
-}
+double half_ulp(double x) { return ulp_of(x, ColorFormat::rgba16f); }
 
 ErrorStats compare_color(const ColorImage& got, const FogResult<double>& ref, const ColorImage& in,
                          const glm::vec3& fog_color) {
@@ -125,14 +121,7 @@ ErrorStats compare_color(const ColorImage& got, const FogResult<double>& ref, co
 }
 
 double factor_error(const ColorImage& probe, const FogResult<double>& ref) {
-  double worst = 0;
-  for (int y = 0; y < probe.height(); ++y)
-    for (int x = 0; x < probe.width(); ++x) {
-      const double f = ref.factor[std::size_t(y) * probe.width() + x];
-      const glm::vec4 p = probe.pixel(x, y);
-      for (int ch = 0; ch < 3; ++ch) worst = std::max(worst, std::fabs(double(p[ch]) - f));
-    }
-  return worst;
+  return max_abs_factor_error(probe, ref);
 }
 
 ColorImage white_like(const ColorImage& like) {

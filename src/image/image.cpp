@@ -1,6 +1,7 @@
 #include "fogcl/image.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -110,6 +111,18 @@ void validate_frame(const ColorImage& color, const DepthImage& depth) {
     throw Error("color is " + std::to_string(color.width()) + "x" + std::to_string(color.height()) +
                 " but depth is " + std::to_string(depth.width()) + "x" + std::to_string(depth.height()) +
                 ": they must be the same size");
+}
+
+double srgb_encode(double linear) {
+  return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+double ulp_of(double x, ColorFormat format) {
+  x = std::fabs(x);
+  if (format == ColorFormat::rgba16f)
+    return x < 6.103515625e-05 ? std::ldexp(1.0, -24) : std::ldexp(1.0, int(std::floor(std::log2(x))) - 10);
+  if (x < 1.1754943508222875e-38) return std::ldexp(1.0, -149);
+  return std::ldexp(1.0, int(std::floor(std::log2(x))) - 23);
 }
 
 ColorImage uniform_image(int width, int height, ColorFormat format, const glm::vec4& rgba) {

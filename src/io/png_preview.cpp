@@ -25,12 +25,6 @@ namespace fogcl {
 
 namespace {
 
-// sRGB transfer function (IEC 61966-2-1:1999, §5.2, the piecewise "encoding" of linear light):
-// 12.92 * L for L <= 0.0031308, else 1.055 * L^(1/2.4) - 0.055. L in [0, 1].
-float srgb_encode(float linear) {
-  return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
-}
-
 // SplitMix64's output function (Steele, Lea, Flood, "Fast splittable pseudorandom number
 // generators", OOPSLA 2014; constants of Stafford's "Mix13"): a bijective 64-bit mixer, used as a
 // stateless per-pixel hash so that the same image always gives the same PNG.
@@ -69,7 +63,7 @@ std::uint8_t encode_color(float linear, int x, int y, int channel) {
   // add bias and noise to flat black or saturated areas.
   if (l == 0.0f) return 0;
   if (l == 1.0f) return 255;
-  return quantise(srgb_encode(l) * 255.0f + tpdf_dither(x, y, channel));
+  return quantise(float(srgb_encode(l)) * 255.0f + tpdf_dither(x, y, channel));
 }
 
 }  // namespace

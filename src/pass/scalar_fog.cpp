@@ -149,6 +149,20 @@ double max_abs_rgb_error(const ColorImage& image, const FogResult<double>& refer
   return worst;
 }
 
+double max_abs_factor_error(const ColorImage& probe, const FogResult<double>& reference) {
+  double worst = 0;
+  for (int y = 0; y < probe.height(); ++y)
+    for (int x = 0; x < probe.width(); ++x) {
+      const glm::vec4 p = probe.pixel(x, y);
+      const double f = reference.factor[std::size_t(y) * std::size_t(probe.width()) + std::size_t(x)];
+      for (int c = 0; c < 3; ++c) {
+        const double e = std::fabs(double(p[c]) - f);
+        worst = std::max(worst, std::isnan(e) ? INFINITY : e);
+      }
+    }
+  return worst;
+}
+
 template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,
                                             const FogSettings&);
 template FogResult<double> fog_scalar<double>(const ColorImage&, const DepthImage&,

@@ -88,20 +88,10 @@ double eye_depth_rel_err(const CameraParams& cam) {
   return worst;
 }
 
-// One ulp of the storage type at |x|.
-double ulp_at(double x, ColorFormat storage) {
-  x = std::fabs(x);
-  if (storage == ColorFormat::rgba16f)
-    return x < 6.103515625e-05 ? std::ldexp(1.0, -24) : std::ldexp(1.0, int(std::floor(std::log2(x))) - 10);
-  if (x < double(std::numeric_limits<float>::min())) return std::ldexp(1.0, -149);
-  return std::ldexp(1.0, int(std::floor(std::log2(x))) - 23);
-}
-
 // 8-bit sRGB code: NaN -> 0, clamp to [0, 1], IEC 61966-2-1 encode, round; no dither.
 int srgb8(double linear) {
   const double l = std::isnan(linear) ? 0.0 : std::clamp(linear, 0.0, 1.0);
-  const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
-  return int(std::lround(e * 255.0));
+  return int(std::lround(srgb_encode(l) * 255.0));
 }
 
 std::size_t nonfinite_from_finite(const ColorImage& out, const ColorImage& in) {
@@ -128,7 +118,7 @@ void color_errors(const ColorImage& out, const ColorImage& in, const FogResult<d
         const double r = ref.rgba[4 * i + std::size_t(c)];
         const double e = std::fabs(double(g[c]) - r);
         errs.push_back(std::isnan(e) ? std::numeric_limits<double>::infinity() : e);
-        row.max_ulp = std::max(row.max_ulp, errs.back() / ulp_at(r, row.storage));
+        row.max_ulp = std::max(row.max_ulp, errs.back() / ulp_of(r, row.storage));
         differs = differs || srgb8(double(g[c])) != srgb8(r);
       }
       off += differs;
@@ -139,20 +129,6 @@ void color_errors(const ColorImage& out, const ColorImage& in, const FogResult<d
   row.p999_abs_err_color = errs[k];
   row.pct_8bit_off = 100.0 * double(off) / double(in.pixel_count());
   row.nonfinite += nonfinite_from_finite(out, in);
-}
-
-double factor_error(const ColorImage& probe, const FogResult<double>& ref) {
-  double worst = 0;
-  for (int y = 0; y < probe.height(); ++y)
-    for (int x = 0; x < probe.width(); ++x) {
-      const double f = ref.factor[std::size_t(y) * std::size_t(probe.width()) + std::size_t(x)];
-      const glm::vec4 p = probe.pixel(x, y);
-      for (int c = 0; c < 3; ++c) {
-        const double e = std::fabs(double(p[c]) - f);
-        worst = std::max(worst, std::isnan(e) ? std::numeric_limits<double>::infinity() : e);
-      }
-    }
-  return worst;
 }
 
 ColorImage white_like(const ColorImage& like) {
@@ -293,7 +269,7 @@ Report run_report(const Runtime* runtime, const ReportOptions& o) {
           row.time_ms = device_run(*runtime, *pass, in, scene.frame.depth, out, scene.frame.params, s, o.runs);
           device_run(*runtime, *pass, white, scene.frame.depth, probe, scene.frame.params, ps, 0);
           color_errors(out, in, ref, row);
-          row.max_abs_err_factor = factor_error(probe, ref_probe);
+          row.max_abs_err_factor = max_abs_factor_error(probe, ref_probe);
           row.nonfinite += nonfinite_from_finite(probe, white);
           rows.push_back(row);
         }
@@ -306,7 +282,7 @@ Report run_report(const Runtime* runtime, const ReportOptions& o) {
         row.time_ms = scalar_run(in, scene.frame.depth, out, scene.frame.params, scene.settings, o.runs);
         apply_fog_scalar(white, scene.frame.depth, probe, scene.frame.params, probe_settings);
         color_errors(out, in, ref, row);
-        row.max_abs_err_factor = factor_error(probe, ref_probe);
+        row.max_abs_err_factor = max_abs_factor_error(probe, ref_probe);
         row.nonfinite += nonfinite_from_finite(probe, white);
         rows.push_back(row);
       }

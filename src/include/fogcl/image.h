@@ -102,6 +102,14 @@ void validate_frame(const ColorImage& color, const DepthImage& depth);
 // output equal the fog factor).
 ColorImage uniform_image(int width, int height, ColorFormat format, const glm::vec4& rgba);
 
+// sRGB transfer function (IEC 61966-2-1:1999, §5.2): linear light in [0, 1] to the encoded value
+// in [0, 1]; 12.92 L for L <= 0.0031308, else 1.055 L^(1/2.4) - 0.055.
+double srgb_encode(double linear);
+
+// One unit in the last place of the storage format at |x| (half: 2^-24 in the subnormal range;
+// float: 2^-149 there).
+double ulp_of(double x, ColorFormat format);
+
 // Converts a color image to another storage format (round to nearest even for half).
 ColorImage convert(const ColorImage& image, ColorFormat format);
 

@@ -38,6 +38,10 @@ FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const Cam
 // the "max error against the float64 path" every tool of the project reports.
 double max_abs_rgb_error(const ColorImage& image, const FogResult<double>& reference);
 
+// The same for the fog factor, from a probe run (color (1, 1, 1, 1), fog color 0: every output
+// channel is f): max |probe RGB - reference.factor|.
+double max_abs_factor_error(const ColorImage& probe, const FogResult<double>& reference);
+
 extern template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&,
                                                    const CameraParams&, const FogSettings&);
 extern template FogResult<double> fog_scalar<double>(const ColorImage&, const DepthImage&,
