@@ -31,6 +31,7 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
   const auto& c = cam.frustum_corners;
   const float fr = fog.r, fg = fog.g, fb = fog.b;
   const int projection = int(cam.projection);
+  const float inv_width = 1.0f / float(w);
 #pragma omp parallel num_threads(threads)
   {
     std::vector<float> factor(static_cast<std::size_t>(w));
@@ -43,7 +44,7 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
       for (int x = 0; x < w; ++x) {
         float ray_length = 0.0f;
         if constexpr (kDistance) {
-          const float u = fog_pixel_u(float(x), float(w));
+          const float u = fog_pixel_u(float(x), inv_width);
           ray_length = fog_ray_length(fog_bilerp(c[0].x, c[1].x, c[2].x, c[3].x, u, vv),
                                       fog_bilerp(c[0].y, c[1].y, c[2].y, c[3].y, u, vv),
                                       fog_bilerp(c[0].z, c[1].z, c[2].z, c[3].z, u, vv));

@@ -5,9 +5,10 @@
  *     exactly like the scalar version);
  *   - C++ (src/pass/scalar_fog.cpp): FOG_FN makes each function a template on FOG_REAL, so the
  *     same text runs in float for the baseline and in double for the reference.
- * The includer defines FOG_INT and FOG_NAME (and FOG_REAL, FOG_AS_UINT in OpenCL C); this file has no include
- * guard on purpose. Only operations that exist in both languages appear: + - * /, fma, exp2,
- * expm1, sqrt, fmin, fmax and ?: (a per-lane select on vectors in OpenCL C).
+ * The includer defines FOG_INT, FOG_NAME, FOG_AS_INT, FOG_AS_REAL (bit casts) and FOG_EXP2 (the
+ * exp2 of the factors), plus FOG_REAL and FOG_AS_UINT in OpenCL C; this file has no include
+ * guard on purpose. Only operations that exist in both languages appear: + - * /, fma, expm1,
+ * sqrt, fmin, fmax, integer + and <<, and ?: (a per-lane select on vectors in OpenCL C).
  * Sources: Unity's UnityCG.cginc (Linear01Depth, UNITY_CALC_FOG_FACTOR_RAW) and Catlike Coding,
  * "Rendering 14: Fog" (deferred fog, depth vs distance, the skybox test). */
 
@@ -31,9 +32,10 @@
 #endif
 
 /* Pixel centre to Unity uv: u grows to the right, v grows upwards (row 0 is the top row).
- * x, y are pixel indices converted to FOG_REAL (exact below 2^24). */
-FOG_FN FOG_REAL FOG_NAME(fog_pixel_u)(FOG_REAL x, FOG_REAL width) {
-  return (x + (FOG_REAL)0.5f) / width;
+ * x, y are pixel indices converted to FOG_REAL (exact below 2^24). u multiplies by the
+ * per-frame 1 / width: a division per pixel costs more than the half ulp it would save. */
+FOG_FN FOG_REAL FOG_NAME(fog_pixel_u)(FOG_REAL x, FOG_REAL inv_width) {
+  return (x + (FOG_REAL)0.5f) * inv_width;
 }
 FOG_FN FOG_REAL FOG_NAME(fog_pixel_v)(FOG_REAL y, FOG_REAL height) {
   return (FOG_REAL)1 - (y + (FOG_REAL)0.5f) / height;
@@ -45,13 +47,13 @@ FOG_FN FOG_REAL FOG_NAME(fog_pixel_v)(FOG_REAL y, FOG_REAL height) {
  * costs one multiply-add per component. */
 FOG_FN FOG_REAL FOG_NAME(fog_bilerp)(FOG_REAL bl, FOG_REAL br, FOG_REAL tl, FOG_REAL tr,
                                      FOG_REAL u, FOG_REAL v) {
-  FOG_REAL left = bl + (tl - bl) * v;
-  FOG_REAL right = br + (tr - br) * v;
-  return left + (right - left) * u;
+  FOG_REAL left = fma(tl - bl, v, bl);
+  FOG_REAL right = fma(tr - br, v, br);
+  return fma(right - left, u, left);
 }
 
 FOG_FN FOG_REAL FOG_NAME(fog_ray_length)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz) {
-  return sqrt(rx * rx + ry * ry + rz * rz);
+  return sqrt(fma(rx, rx, fma(ry, ry, rz * rz)));
 }
 
 /* NaN test that survives -cl-fast-relaxed-math (which may fold x != x away): the bit pattern.
@@ -114,16 +116,40 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_step)(FOG_REAL d, FOG_REAL start) {
   return d < start ? (FOG_REAL)1 : (FOG_REAL)0;
 }
 
+/* 2^x for the fog factors, x <= 0 (x > 0 gives 1). Cody-Waite split x = n + r, n = rint(x),
+ * |r| <= 1/2 (adding 1.5 * 2^23 rounds x to an integer and leaves n in the low mantissa bits),
+ * and a degree-6 polynomial for 2^r: the Chebyshev fit of 2^r on [-1/2, 1/2]
+ * (scripts/exp2_coefficients.py), rounded to float, with p(0) = 1 exactly. Results below 2^-126
+ * are flushed to 0 — a denormal factor changes no color, and computing one costs microcode
+ * assists on x86. Worst error over every float in [-126, 0]: 0.99 ulp (tests/exp2_test.cpp).
+ * Vendor exp2 routines are library calls on CPU OpenCL devices that this replaces with 15
+ * vector instructions. Includers reach it through FOG_EXP2: every float path uses it, the double
+ * reference keeps the C library's exp2. */
+FOG_FN FOG_REAL FOG_NAME(fog_exp2_poly)(FOG_REAL x) {
+  FOG_REAL xc = x < (FOG_REAL)-126 ? (FOG_REAL)-126 : (x > (FOG_REAL)0 ? (FOG_REAL)0 : x);
+  FOG_REAL s = xc + (FOG_REAL)0x1.8p23f;
+  FOG_REAL r = xc - (s - (FOG_REAL)0x1.8p23f);
+  FOG_REAL p = (FOG_REAL)0x1.444p-13f;
+  p = fma(p, r, (FOG_REAL)0x1.5f48cp-10f);
+  p = fma(p, r, (FOG_REAL)0x1.3b2a1cp-7f);
+  p = fma(p, r, (FOG_REAL)0x1.c6aeccp-5f);
+  p = fma(p, r, (FOG_REAL)0x1.ebfbep-3f);
+  p = fma(p, r, (FOG_REAL)0x1.62e43p-1f);
+  p = fma(p, r, (FOG_REAL)1);
+  FOG_REAL scale = FOG_AS_REAL((FOG_AS_INT(s) + (127 - 0x4b400000)) << 23); /* 2^n */
+  return x < (FOG_REAL)-126 ? (FOG_REAL)0 : p * scale;
+}
+
 /* Exp: f = exp2(-d * density / ln 2) = e^(-density d); k = density * log2(e). */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_exp)(FOG_REAL d, FOG_REAL k) {
-  return FOG_NAME(fog_saturate)(exp2(-(d * k)));
+  return FOG_NAME(fog_saturate)(FOG_EXP2(-(d * k)));
 }
 
 /* Exp2: f = exp2(-(d * density / sqrt(ln 2))^2) = e^(-(density d)^2); k = density / sqrt(ln 2).
  * A huge d * k squares to +inf and exp2(-inf) = 0: no NaN. */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL d, FOG_REAL k) {
   FOG_REAL t = d * k;
-  return FOG_NAME(fog_saturate)(exp2(-(t * t)));
+  return FOG_NAME(fog_saturate)(FOG_EXP2(-(t * t)));
 }
 
 /* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky. The int
@@ -184,7 +210,12 @@ FOG_FN FOG_REAL FOG_NAME(fog_amount)(FOG_REAL raw, FOG_REAL ray_length, int mode
 }
 
 /* Blend one channel: fogColor + f * (c - fogColor). f == 1 returns c untouched (bit-exact, NaN
- * and Inf included) and f == 0 returns exactly the fog color (a hidden NaN never leaks). */
+ * and Inf included) and f == 0 returns exactly the fog color (a hidden NaN never leaks).
+ * fog_blend_mix is the formula alone, for callers that know 0 < f < 1. */
+FOG_FN FOG_REAL FOG_NAME(fog_blend_mix)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) {
+  return fma(f, c - fog_color, fog_color);
+}
 FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) {
-  return f == (FOG_REAL)1 ? c : (f == (FOG_REAL)0 ? fog_color : fma(f, c - fog_color, fog_color));
+  return f == (FOG_REAL)1 ? c
+       : (f == (FOG_REAL)0 ? fog_color : FOG_NAME(fog_blend_mix)(c, fog_color, f));
 }

@@ -40,18 +40,19 @@ void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera)
   const int w = depth.width(), h = depth.height();
   const double far_plane = double(camera.far_plane());
   const auto& c = camera.frustum_corners;
+  const double inv_width = 1.0 / double(w);
   for (int y = 0; y < h; ++y) {
     const double v = depth_math::fog_pixel_v<double>(y, h);
     for (int x = 0; x < w; ++x) {
       float& d = depth.at(x, y);
       double eye = double(d);
       if (kind == DepthKind::distance) {
-        const double u = depth_math::fog_pixel_u<double>(x, w);
+        const double u = depth_math::fog_pixel_u<double>(x, inv_width);
         double ray[3];
         for (int k = 0; k < 3; ++k)
           ray[k] = depth_math::fog_bilerp<double>(c[kBottomLeft][k], c[kBottomRight][k], c[kTopLeft][k],
                                                   c[kTopRight][k], u, v);
-        const double length = std::sqrt(ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]);
+        const double length = depth_math::fog_ray_length<double>(ray[0], ray[1], ray[2]);
         eye = eye * far_plane / length;  // non-finite / <= 0 stay so, and become sky below
       }
       d = float(raw_from_eye_depth(eye, camera));

@@ -38,13 +38,14 @@ void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParam
   const float* raw_depth = depth.data();
   const int mode = int(v.mode), distance = v.distance, skybox = v.fog_skybox, reversed = v.reversed_z;
   const int projection = int(v.projection);
+  const T inv_width = T(1) / T(w);
   for (int y = 0; y < h; ++y) {
     const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
       T ray_length = 0;
       if (distance) {
-        const T u = fog_pixel_u(T(x), T(w));
+        const T u = fog_pixel_u(T(x), inv_width);
         T ray[3];
         for (int c = 0; c < 3; ++c)
           ray[c] = fog_bilerp(T(cn[kBottomLeft][c]), T(cn[kBottomRight][c]), T(cn[kTopLeft][c]),
