@@ -190,7 +190,9 @@ Runtime* runtime(benchmark::State& state) {
 }
 
 FogPass& shared_pass(Runtime& rt, bool streaming_stores = false) {
-  static FogPass streaming(rt, true), plain(rt, false);
+  CpuCodegen nt;
+  nt.streaming_stores = true;
+  static FogPass streaming(rt, nt), plain(rt);
   return streaming_stores ? streaming : plain;
 }
 

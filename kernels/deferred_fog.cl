@@ -11,6 +11,7 @@
  *   FOG_NATIVE_MATH   native_exp2 / native_sqrt (the `fast` precision, with -cl-fast-relaxed-math)
  *   FOG_VECTOR_WIDTH  pixels per work-item: 16 on CPU devices, 1 elsewhere.
  *   FOG_STREAMING_STORES  non-temporal stores of RGBA32F blocks (CPU devices)
+ *   FOG_PORTABLE      CPU devices: OpenCL C only, no target builtins (see fog_pixels16)
  *
  * Why 16 pixels per work-item on CPUs: PoCL vectorises only across work-items, and a library
  * exp2 blocks that. Explicit float16 arithmetic maps straight onto SIMD registers, one lane per
@@ -136,7 +137,7 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
 }
 
 #if FOG_VECTOR_WIDTH == 16
-#if defined(__clang__) && defined(__AVX512F__)
+#if defined(__clang__) && defined(__AVX512F__) && !defined(FOG_PORTABLE)
 /* x86 AVX-512 (PoCL on such CPUs): compares straight into mask registers and 16-wide half
  * conversions. The portable fallbacks below compile everywhere; LLVM splits their half
  * conversions into 8-wide halves and their lane reductions into scalar chains. */

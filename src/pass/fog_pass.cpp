@@ -30,10 +30,10 @@ FogPass::FogPass(cl::Context context, cl::Device device)
   });
 }
 
-FogPass::FogPass(const Runtime& runtime, bool streaming_stores)
+FogPass::FogPass(const Runtime& runtime, const CpuCodegen& codegen)
     : FogPass(runtime.context(), runtime.device()) {
   queue_ = runtime.queue();
-  traits_.streaming_stores = streaming_stores;
+  traits_.codegen = codegen;
 }
 
 cl::Kernel& FogPass::kernel_for(const Variant& variant) {

@@ -53,7 +53,9 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
-  if (device.cpu && device.streaming_stores && v.storage == ColorFormat::rgba32f) o += " -D FOG_STREAMING_STORES";
+  if (device.cpu && device.codegen.streaming_stores && v.storage == ColorFormat::rgba32f)
+    o += " -D FOG_STREAMING_STORES";
+  if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }
 

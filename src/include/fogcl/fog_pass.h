@@ -39,8 +39,8 @@ class FogPass {
  public:
   // Integration: programs are built for `device` in the caller's `context`.
   FogPass(cl::Context context, cl::Device device);
-  // Convenience: the runtime's context, device and queue. streaming_stores: see DeviceTraits.
-  explicit FogPass(const Runtime& runtime, bool streaming_stores = false);
+  // Convenience: the runtime's context, device and queue. codegen: see CpuCodegen.
+  explicit FogPass(const Runtime& runtime, const CpuCodegen& codegen = {});
 
   // Enqueues the pass on `queue` (of this pass's context and device) after `wait_list` and
   // returns the event of its last command. Never blocks the host. Fog off (or density 0)

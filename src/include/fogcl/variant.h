@@ -39,14 +39,24 @@ struct Variant {
 // Validates the settings and derives the variant. Throws fogcl::Error on invalid settings.
 Variant select_variant(const FogSettings& settings, const CameraParams& camera, ColorFormat storage);
 
+// Code generation choices of the CPU kernel path, for benchmarks and tests; the defaults are
+// what fogcl uses.
+struct CpuCodegen {
+  // Write RGBA32F output with non-temporal stores (no read-for-ownership of the output). Off:
+  // measured slower on PoCL 3.1 / 2-core EPYC (1.50 vs 1.00 ms at 1080p, linear fog), where a
+  // 1080p frame partly stays in the large L3. bench/ keeps measuring it.
+  bool streaming_stores = false;
+  // Use the target's SIMD builtins where the kernel has them (x86 AVX-512: lane masks, 16-wide
+  // half conversions). false builds the portable OpenCL C path that other CPUs run, so that
+  // tests on an AVX-512 machine cover it too.
+  bool target_intrinsics = true;
+};
+
 // What the build options depend on besides the scene.
 struct DeviceTraits {
   std::string opencl_c_version = "OpenCL C 1.2";  // CL_DEVICE_OPENCL_C_VERSION
   bool cpu = true;                                // CL_DEVICE_TYPE_CPU
-  // CPU devices: write RGBA32F output with non-temporal stores (no read-for-ownership of the
-  // output). Off by default: measured slower on PoCL 3.1 / 2-core EPYC (1.50 vs 1.00 ms at 1080p,
-  // linear fog), where a 1080p frame partly stays in the large L3. bench/ keeps measuring it.
-  bool streaming_stores = false;
+  CpuCodegen codegen;                             // read on CPU devices only
 };
 
 // Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
