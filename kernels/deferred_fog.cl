@@ -8,7 +8,8 @@
  *   REVERSED_Z        depth 1 at near, 0 at far (decides where a NaN depth lands: the far end)
  *   FOG_PROJECTION    0 perspective (default), 1 reversed-Z infinite far, 2 orthographic
  *   FOG_COLOR_HALF    color stored as RGBA half; else RGBA float
- *   FOG_NATIVE_MATH   native_exp2 / native_sqrt (the `fast` precision, with -cl-fast-relaxed-math)
+ *   FOG_NATIVE_MATH   native_sqrt, and native_exp2 on GPUs (the `fast` precision, with
+ *                     -cl-fast-relaxed-math)
  *   FOG_VECTOR_WIDTH  pixels per work-item: 16 on CPU devices, 1 elsewhere.
  *   FOG_STREAMING_STORES  non-temporal stores of RGBA32F blocks (CPU devices)
  *   FOG_PORTABLE      CPU devices: OpenCL C only, no target builtins (see fog_pixels16)
@@ -30,8 +31,13 @@
 #define FOG_VECTOR_WIDTH 1
 #endif
 #ifdef FOG_NATIVE_MATH
-#define FOG_EXP2 native_exp2
+#undef sqrt /* PoCL's headers define it as a macro under -cl-fast-relaxed-math */
 #define sqrt native_sqrt
+#if FOG_VECTOR_WIDTH == 1
+/* The contract of fog_exp2_poly: 2^min(x, 0). CPU devices keep the polynomial: it is faster than
+ * PoCL's native_exp2 (1080p exp2 fog 1.06 vs 1.24 ms) and accurate. */
+#define FOG_EXP2(x) native_exp2(fmin((x), 0.0f))
+#endif
 #endif
 #ifdef FOG_DISTANCE
 #define FOG_USE_DISTANCE 1
@@ -59,28 +65,32 @@
 #define FOG_REAL float
 #define FOG_INT int
 #define FOG_AS_UINT as_uint
-#define FOG_AS_INT as_int
+#define FOG_TRUNC_INT convert_int
+#define FOG_TO_REAL convert_float
 #define FOG_AS_REAL as_float
 #define FOG_NAME(name) name
 #include "fog_math.h"
 #undef FOG_REAL
 #undef FOG_INT
 #undef FOG_AS_UINT
-#undef FOG_AS_INT
+#undef FOG_TRUNC_INT
+#undef FOG_TO_REAL
 #undef FOG_AS_REAL
 #undef FOG_NAME
 
 #define FOG_REAL float16
 #define FOG_INT int16
 #define FOG_AS_UINT as_uint16
-#define FOG_AS_INT as_int16
+#define FOG_TRUNC_INT convert_int16
+#define FOG_TO_REAL convert_float16
 #define FOG_AS_REAL as_float16
 #define FOG_NAME(name) name##_v
 #include "fog_math.h"
 #undef FOG_REAL
 #undef FOG_INT
 #undef FOG_AS_UINT
-#undef FOG_AS_INT
+#undef FOG_TRUNC_INT
+#undef FOG_TO_REAL
 #undef FOG_AS_REAL
 #undef FOG_NAME
 

@@ -5,8 +5,8 @@
  *     exactly like the scalar version);
  *   - C++ (src/pass/scalar_fog.cpp): FOG_FN makes each function a template on FOG_REAL, so the
  *     same text runs in float for the baseline and in double for the reference.
- * The includer defines FOG_INT, FOG_NAME, FOG_AS_INT, FOG_AS_REAL (bit casts) and FOG_EXP2 (the
- * exp2 of the factors), plus FOG_REAL and FOG_AS_UINT in OpenCL C; this file has no include
+ * The includer defines FOG_INT, FOG_NAME and the hooks of fog_exp2_poly (FOG_EXP2, FOG_TRUNC_INT,
+ * FOG_TO_REAL, FOG_AS_REAL), plus FOG_REAL and FOG_AS_UINT in OpenCL C; this file has no include
  * guard on purpose. Only operations that exist in both languages appear: + - * /, fma, expm1,
  * sqrt, fmin, fmax, integer + and <<, and ?: (a per-lane select on vectors in OpenCL C).
  * Sources: Unity's UnityCG.cginc (Linear01Depth, UNITY_CALC_FOG_FACTOR_RAW) and Catlike Coding,
@@ -116,19 +116,27 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_step)(FOG_REAL d, FOG_REAL start) {
   return d < start ? (FOG_REAL)1 : (FOG_REAL)0;
 }
 
-/* 2^x for the fog factors, x <= 0 (x > 0 gives 1). Cody-Waite split x = n + r, n = rint(x),
- * |r| <= 1/2 (adding 1.5 * 2^23 rounds x to an integer and leaves n in the low mantissa bits),
- * and a degree-6 polynomial for 2^r: the Chebyshev fit of 2^r on [-1/2, 1/2]
- * (scripts/exp2_coefficients.py), rounded to float, with p(0) = 1 exactly. Results below 2^-126
- * are flushed to 0 — a denormal factor changes no color, and computing one costs microcode
- * assists on x86. Worst error over every float in [-126, 0]: 0.99 ulp (tests/exp2_test.cpp).
- * Vendor exp2 routines are library calls on CPU OpenCL devices that this replaces with 15
- * vector instructions. Includers reach it through FOG_EXP2: every float path uses it, the double
- * reference keeps the C library's exp2. */
+/* 2^min(x, 0), the fog factors' exp2: in [0, 1] for every x, so callers need no saturate.
+ * Cody-Waite split x = n + r, n integer, |r| <= 1/2, and a degree-6 polynomial for 2^r: the
+ * Chebyshev fit of 2^r on [-1/2, 1/2] (scripts/exp2_coefficients.py), rounded to float, with
+ * p(0) = 1 exactly. Results below 2^-126 are flushed to 0 — a denormal factor changes no color,
+ * and computing one costs microcode assists on x86. Worst error over every float in [-126, 0]:
+ * 0.97 ulp (tests/exp2_test.cpp). n comes from a float -> int conversion, not from the
+ * add-and-subtract-1.5*2^23 trick, which fast-math reassociation folds away, nor from a
+ * round-to-nearest conversion, a 20-instruction library routine in PoCL.
+ * Vendor exp2 routines are library calls on CPU OpenCL devices; this is 16 vector instructions.
+ * Includers reach it through FOG_EXP2 (every float path; the double reference keeps the C
+ * library's exp2) and define FOG_TRUNC_INT (FOG_REAL to FOG_INT rounding toward zero: C's
+ * cast), FOG_TO_REAL (FOG_INT to FOG_REAL) and FOG_AS_REAL (bit cast). */
 FOG_FN FOG_REAL FOG_NAME(fog_exp2_poly)(FOG_REAL x) {
-  FOG_REAL xc = x < (FOG_REAL)-126 ? (FOG_REAL)-126 : (x > (FOG_REAL)0 ? (FOG_REAL)0 : x);
-  FOG_REAL s = xc + (FOG_REAL)0x1.8p23f;
-  FOG_REAL r = xc - (s - (FOG_REAL)0x1.8p23f);
+  /* Clamped to [-126, 0] by compare-and-select in min/max operand order (one instruction each
+   * on x86; x is never NaN here). */
+  FOG_REAL xc = (FOG_REAL)0 < x ? (FOG_REAL)0 : x;
+  xc = (FOG_REAL)-126 > xc ? (FOG_REAL)-126 : xc;
+  /* n = ceil(xc - 1/2) by truncation (xc - 1/2 < 0), one conversion instruction; the rounding
+   * of xc - 1/2 can put r a rounding error past +-1/2, where the fit still holds. */
+  FOG_INT n = FOG_TRUNC_INT(xc - (FOG_REAL)0.5f);
+  FOG_REAL r = xc - FOG_TO_REAL(n);
   FOG_REAL p = (FOG_REAL)0x1.444p-13f;
   p = fma(p, r, (FOG_REAL)0x1.5f48cp-10f);
   p = fma(p, r, (FOG_REAL)0x1.3b2a1cp-7f);
@@ -136,20 +144,20 @@ FOG_FN FOG_REAL FOG_NAME(fog_exp2_poly)(FOG_REAL x) {
   p = fma(p, r, (FOG_REAL)0x1.ebfbep-3f);
   p = fma(p, r, (FOG_REAL)0x1.62e43p-1f);
   p = fma(p, r, (FOG_REAL)1);
-  FOG_REAL scale = FOG_AS_REAL((FOG_AS_INT(s) + (127 - 0x4b400000)) << 23); /* 2^n */
+  FOG_REAL scale = FOG_AS_REAL((n + 127) << 23); /* 2^n, n in [-126, 0] */
   return x < (FOG_REAL)-126 ? (FOG_REAL)0 : p * scale;
 }
 
 /* Exp: f = exp2(-d * density / ln 2) = e^(-density d); k = density * log2(e). */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_exp)(FOG_REAL d, FOG_REAL k) {
-  return FOG_NAME(fog_saturate)(FOG_EXP2(-(d * k)));
+  return FOG_EXP2(-(d * k)); /* in [0, 1]: no saturate */
 }
 
 /* Exp2: f = exp2(-(d * density / sqrt(ln 2))^2) = e^(-(density d)^2); k = density / sqrt(ln 2).
  * A huge d * k squares to +inf and exp2(-inf) = 0: no NaN. */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL d, FOG_REAL k) {
   FOG_REAL t = d * k;
-  return FOG_NAME(fog_saturate)(FOG_EXP2(-(t * t)));
+  return FOG_EXP2(-(t * t));
 }
 
 /* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky. The int

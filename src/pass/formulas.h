@@ -14,31 +14,30 @@ using std::fmin;
 using std::isnan;
 using std::sqrt;
 
-inline std::int32_t fog_as_int(float x) {
-  std::int32_t i;
-  std::memcpy(&i, &x, sizeof i);
-  return i;
-}
+inline int fog_trunc_int(float x) { return int(x); }
+inline float fog_to_real(int n) { return float(n); }
 inline float fog_as_real(std::int32_t i) {
   float x;
   std::memcpy(&x, &i, sizeof x);
   return x;
 }
-// The exp2 of the fog factors: float paths run the kernel's polynomial (the same bits as the
-// OpenCL kernel), the double reference the C library's exp2. Declared before the templates
+// The exp2 of the fog factors, 2^min(x, 0): float paths run the kernel's polynomial (the same
+// bits as the OpenCL kernel), the double reference the C library's exp2. Declared before the templates
 // that call it: lookup of a dependent call on a fundamental type happens at their definition.
 inline float fog_exp2(float x);
-inline double fog_exp2(double x) { return std::exp2(x); }
+inline double fog_exp2(double x) { return std::exp2(std::fmin(x, 0.0)); }
 
 #define FOG_INT int
 #define FOG_NAME(name) name
-#define FOG_AS_INT fog_as_int
+#define FOG_TRUNC_INT fog_trunc_int
+#define FOG_TO_REAL fog_to_real
 #define FOG_AS_REAL fog_as_real
 #define FOG_EXP2 fog_exp2
 #include "fog_math.h"
 #undef FOG_INT
 #undef FOG_NAME
-#undef FOG_AS_INT
+#undef FOG_TRUNC_INT
+#undef FOG_TO_REAL
 #undef FOG_AS_REAL
 #undef FOG_EXP2
 
