@@ -10,6 +10,26 @@
 #include "pass/formulas.h"
 #include "settings/fog_coefficients.h"
 
+// The user-facing float path is compiled twice, for CPUs with FMA and for the x86-64 baseline,
+// and the loader picks one (function multiversioning): without hardware FMA every fma() of the
+// formulas is a libm call, which made the distance-based loop 2x slower. Its callees are forced
+// inline so that they are compiled for the clone's target.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(undefined_behavior_sanitizer)
+#define FOGCL_SANITIZED 1  // ifunc resolvers run before the sanitizer runtime is up
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define FOGCL_SANITIZED 1
+#endif
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__ELF__) && !defined(FOGCL_SANITIZED)
+#define FOGCL_TARGET_CLONES __attribute__((target_clones("fma", "default")))
+#define FOGCL_INLINE [[gnu::always_inline]] inline
+#else
+#define FOGCL_TARGET_CLONES
+#define FOGCL_INLINE inline
+#endif
+
 namespace fogcl {
 
 namespace {
@@ -25,7 +45,7 @@ float load_channel(const std::uint16_t* p) {
 // with the fog factor, the fog amount 1 - f (only if with_amount, else 0) and the blended color
 // (alpha passed through), all in T.
 template <class T, class Channel, class Sink>
-void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParams& cam,
+FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParams& cam,
                 const Variant& v, const FogSettings& s, bool with_amount, Sink&& sink) {
   using namespace detail;
   using namespace formulas;
@@ -70,7 +90,7 @@ void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParam
 
 // Runs fog_pixels with the channel type of the image's storage.
 template <class T, class Sink>
-void fog_image(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+FOGCL_INLINE void fog_image(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
                const Variant& v, const FogSettings& s, bool with_amount, Sink&& sink) {
   if (in.format() == ColorFormat::rgba32f)
     fog_pixels<T>(in.rgba32f(), depth, cam, v, s, with_amount, sink);
@@ -85,18 +105,9 @@ Variant checked_variant(const ColorImage& in, const DepthImage& depth, const Cam
   return select_variant(s, cam, in.format());
 }
 
-}  // namespace
-
-void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
-                      const CameraParams& cam, const FogSettings& s) {
-  const Variant v = checked_variant(in, depth, cam, s);
-  if (&out != &in && (out.width() != in.width() || out.height() != in.height() ||
-                      out.format() != in.format()))
-    out = ColorImage(in.width(), in.height(), in.format());
-  if (!v.needs_pass()) {
-    if (&out != &in) std::memcpy(out.data(), in.data(), in.size_bytes());
-    return;
-  }
+// The float path of apply_fog_scalar (see FOGCL_TARGET_CLONES).
+FOGCL_TARGET_CLONES void fog_into(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+                                  const Variant& v, const FogSettings& s, ColorImage& out) {
   const std::size_t pixel_bytes = bytes_per_pixel(in.format());
   const auto* src = static_cast<const std::byte*>(in.data());
   auto* dst = static_cast<std::byte*>(out.data());
@@ -116,6 +127,21 @@ void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage&
       o[4 * i + 3] = in.rgba16f()[4 * i + 3];
     });
   }
+}
+
+}  // namespace
+
+void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                      const CameraParams& cam, const FogSettings& s) {
+  const Variant v = checked_variant(in, depth, cam, s);
+  if (&out != &in && (out.width() != in.width() || out.height() != in.height() ||
+                      out.format() != in.format()))
+    out = ColorImage(in.width(), in.height(), in.format());
+  if (!v.needs_pass()) {
+    if (&out != &in) std::memcpy(out.data(), in.data(), in.size_bytes());
+    return;
+  }
+  fog_into(in, depth, cam, v, s, out);
 }
 
 template <class T>
