@@ -69,14 +69,7 @@
 #define FOG_TO_REAL convert_float
 #define FOG_AS_REAL as_float
 #define FOG_NAME(name) name
-#include "fog_math.h"
-#undef FOG_REAL
-#undef FOG_INT
-#undef FOG_AS_UINT
-#undef FOG_TRUNC_INT
-#undef FOG_TO_REAL
-#undef FOG_AS_REAL
-#undef FOG_NAME
+#include "fog_math.h" /* undefines the instance macros above */
 
 #define FOG_REAL float16
 #define FOG_INT int16
@@ -85,14 +78,7 @@
 #define FOG_TO_REAL convert_float16
 #define FOG_AS_REAL as_float16
 #define FOG_NAME(name) name##_v
-#include "fog_math.h"
-#undef FOG_REAL
-#undef FOG_INT
-#undef FOG_AS_UINT
-#undef FOG_TRUNC_INT
-#undef FOG_TO_REAL
-#undef FOG_AS_REAL
-#undef FOG_NAME
+#include "fog_math.h" /* undefines the instance macros above */
 
 #ifdef FOG_COLOR_HALF
 #define COLOR_T half

@@ -7,8 +7,9 @@
  *     same text runs in float for the baseline and in double for the reference.
  * The includer defines FOG_INT, FOG_NAME and the hooks of fog_exp2_poly (FOG_EXP2, FOG_TRUNC_INT,
  * FOG_TO_REAL, FOG_AS_REAL), plus FOG_REAL and FOG_AS_UINT in OpenCL C; this file has no include
- * guard on purpose. Only operations that exist in both languages appear: + - * /, fma, expm1,
- * sqrt, fmin, fmax, integer + and <<, and ?: (a per-lane select on vectors in OpenCL C).
+ * guard on purpose and undefines those instance macros (not FOG_EXP2) at its end. Only
+ * operations that exist in both languages appear: + - * /, fma, expm1, sqrt, fmin, fmax, integer
+ * + and <<, a float -> int conversion, and ?: (a per-lane select on vectors in OpenCL C).
  * Sources: Unity's UnityCG.cginc (Linear01Depth, UNITY_CALC_FOG_FACTOR_RAW) and Catlike Coding,
  * "Rendering 14: Fog" (deferred fog, depth vs distance, the skybox test). */
 
@@ -227,3 +228,13 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
   return f == (FOG_REAL)1 ? c
        : (f == (FOG_REAL)0 ? fog_color : FOG_NAME(fog_blend_mix)(c, fog_color, f));
 }
+
+/* End of this instance: the includer's instance macros go, so the next instance can define its
+ * own (FOG_EXP2 stays: it is written in terms of FOG_NAME). */
+#undef FOG_REAL
+#undef FOG_INT
+#undef FOG_AS_UINT
+#undef FOG_TRUNC_INT
+#undef FOG_TO_REAL
+#undef FOG_AS_REAL
+#undef FOG_NAME

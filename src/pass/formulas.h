@@ -33,12 +33,7 @@ inline double fog_exp2(double x) { return std::exp2(std::fmin(x, 0.0)); }
 #define FOG_TO_REAL fog_to_real
 #define FOG_AS_REAL fog_as_real
 #define FOG_EXP2 fog_exp2
-#include "fog_math.h"
-#undef FOG_INT
-#undef FOG_NAME
-#undef FOG_TRUNC_INT
-#undef FOG_TO_REAL
-#undef FOG_AS_REAL
+#include "fog_math.h"  // undefines the instance macros
 #undef FOG_EXP2
 
 inline float fog_exp2(float x) { return fog_exp2_poly(x); }
