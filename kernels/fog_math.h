@@ -122,9 +122,9 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_step)(FOG_REAL d, FOG_REAL start) {
  * Chebyshev fit of 2^r on [-1/2, 1/2] (scripts/exp2_coefficients.py), rounded to float, with
  * p(0) = 1 exactly. Results below 2^-126 are flushed to 0 — a denormal factor changes no color,
  * and computing one costs microcode assists on x86. Worst error over every float in [-126, 0]:
- * 0.992 ulp (full sweep; tests/exp2_test.cpp checks every 16th float). n comes from a float -> int conversion, not from the
- * add-and-subtract-1.5*2^23 trick, which fast-math reassociation folds away, nor from a
- * round-to-nearest conversion, a 20-instruction library routine in PoCL.
+ * 0.992 ulp (full sweep; tests/exp2_test.cpp checks every 16th float). n comes from a float ->
+ * int conversion, not from the add-and-subtract-1.5*2^23 trick, which fast-math reassociation
+ * folds away, nor from a round-to-nearest conversion, a 20-instruction library routine in PoCL.
  * Vendor exp2 routines are library calls on CPU OpenCL devices; this is 16 vector instructions.
  * Includers reach it through FOG_EXP2 (every float path; the double reference keeps the C
  * library's exp2) and define FOG_TRUNC_INT (FOG_REAL to FOG_INT rounding toward zero: C's
