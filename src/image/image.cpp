@@ -119,6 +119,7 @@ double srgb_encode(double linear) {
 
 double ulp_of(double x, ColorFormat format) {
   x = std::fabs(x);
+  if (!std::isfinite(x)) return x;  // NaN has no ulp; infinity's is infinite
   if (format == ColorFormat::rgba16f)
     return x < 6.103515625e-05 ? std::ldexp(1.0, -24) : std::ldexp(1.0, int(std::floor(std::log2(x))) - 10);
   if (x < 1.1754943508222875e-38) return std::ldexp(1.0, -149);
