@@ -44,10 +44,7 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
       for (int x = 0; x < w; ++x) {
         float ray_length = 0.0f;
         if constexpr (kDistance) {
-          const float u = fog_pixel_u(float(x), inv_width);
-          ray_length = fog_ray_length(fog_bilerp(c[0].x, c[1].x, c[2].x, c[3].x, u, vv),
-                                      fog_bilerp(c[0].y, c[1].y, c[2].y, c[3].y, u, vv),
-                                      fog_bilerp(c[0].z, c[1].z, c[2].z, c[3].z, u, vv));
+          ray_length = fog_corner_ray_length(c, fog_pixel_u(float(x), inv_width), vv);
         }
         f[x] = fog_factor(d[x], ray_length, kMode, kDistance, kSkybox, kReversed, projection, zx, zy, near_plane,
                           far_plane, k.a, k.b);

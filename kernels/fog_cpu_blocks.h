@@ -1,6 +1,6 @@
 /* fog_cpu_blocks.h — the CPU devices' path of deferred_fog.cl (FOG_VECTOR_WIDTH 16): 16 pixels
  * of a row per work-item, as float16 lanes, and the four per-block blends. Included by
- * deferred_fog.cl after the formula instances, FogConstants and fog_blend_pixel; needs COLOR_T. */
+ * deferred_fog.cl after the formula instances and FogConstants; needs COLOR_T. */
 
 #if defined(__clang__) && defined(__AVX512F__) && !defined(FOG_PORTABLE)
 /* x86 AVX-512 (PoCL on such CPUs): compares straight into mask registers and 16-wide half

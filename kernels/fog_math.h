@@ -184,15 +184,10 @@ FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray_length, i
                   : FOG_NAME(fog_depth_distance)(linear01, near_plane, far_plane);
 }
 
-/* The fog factor f of a pixel from its raw depth: the whole chain of DESIGN.md §2.
- * k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k, density). */
-FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray_length, int mode, int distance,
-                                     int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
-                                     FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
-                                     FOG_REAL k_a, FOG_REAL k_b) {
-  FOG_INT sky;
-  FOG_REAL d = FOG_NAME(fog_view_distance)(raw, ray_length, distance, reversed_z, projection, zx,
-                                           zy, near_plane, far_plane, &sky);
+/* The fog factor f at view distance d (fog_view_distance, which also says whether the pixel is
+ * sky). k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k, density). */
+FOG_FN FOG_REAL FOG_NAME(fog_factor_at)(FOG_REAL d, FOG_INT sky, int mode, int fog_skybox,
+                                        FOG_REAL k_a, FOG_REAL k_b) {
   FOG_REAL f = mode == FOG_MODE_LINEAR ? FOG_NAME(fog_factor_linear)(d, k_a, k_b)
              : mode == FOG_MODE_STEP   ? FOG_NAME(fog_factor_step)(d, k_a)
              : mode == FOG_MODE_EXP    ? FOG_NAME(fog_factor_exp)(d, k_a)
@@ -200,22 +195,29 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray_length, int mode
   return fog_skybox ? f : (sky ? (FOG_REAL)1 : f);
 }
 
-/* The fog amount 1 - f, without the cancellation of computing 1 - f when f is close to 1:
- * exp: -expm1(-density d); exp2: -expm1(-(density d)^2). Linear and step: 1 - f (exact where it
- * matters: f is then far from 1 or exactly 0 / 1). Reported by the scalar path (FogResult). */
-FOG_FN FOG_REAL FOG_NAME(fog_amount)(FOG_REAL raw, FOG_REAL ray_length, int mode, int distance,
-                                     int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
-                                     FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
-                                     FOG_REAL k_a, FOG_REAL k_b) {
-  FOG_INT sky;
-  FOG_REAL d = FOG_NAME(fog_view_distance)(raw, ray_length, distance, reversed_z, projection, zx,
-                                           zy, near_plane, far_plane, &sky);
+/* The fog amount 1 - f at view distance d, without the cancellation of computing 1 - f when f
+ * is close to 1: exp: -expm1(-density d); exp2: -expm1(-(density d)^2). Linear and step: 1 - f
+ * (exact where it matters: f is then far from 1 or exactly 0 / 1). Reported by the scalar path
+ * (FogResult). */
+FOG_FN FOG_REAL FOG_NAME(fog_amount_at)(FOG_REAL d, FOG_INT sky, int mode, int fog_skybox,
+                                        FOG_REAL k_a, FOG_REAL k_b) {
   FOG_REAL x = d * k_b; /* exp / exp2: density * d */
   FOG_REAL a = mode == FOG_MODE_LINEAR ? (FOG_REAL)1 - FOG_NAME(fog_factor_linear)(d, k_a, k_b)
              : mode == FOG_MODE_STEP   ? (FOG_REAL)1 - FOG_NAME(fog_factor_step)(d, k_a)
              : mode == FOG_MODE_EXP    ? -expm1(-x)
                                        : -expm1(-(x * x));
   return fog_skybox ? FOG_NAME(fog_saturate)(a) : (sky ? (FOG_REAL)0 : FOG_NAME(fog_saturate)(a));
+}
+
+/* The fog factor f of a pixel from its raw depth: the whole chain of DESIGN.md §2. */
+FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray_length, int mode, int distance,
+                                     int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
+                                     FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
+                                     FOG_REAL k_a, FOG_REAL k_b) {
+  FOG_INT sky;
+  FOG_REAL d = FOG_NAME(fog_view_distance)(raw, ray_length, distance, reversed_z, projection, zx,
+                                           zy, near_plane, far_plane, &sky);
+  return FOG_NAME(fog_factor_at)(d, sky, mode, fog_skybox, k_a, k_b);
 }
 
 /* Blend one channel: fogColor + f * (c - fogColor). f == 1 returns c untouched (bit-exact, NaN

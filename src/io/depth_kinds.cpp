@@ -47,12 +47,8 @@ void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera)
       float& d = depth.at(x, y);
       double eye = double(d);
       if (kind == DepthKind::distance) {
-        const double u = depth_math::fog_pixel_u<double>(x, inv_width);
-        double ray[3];
-        for (int k = 0; k < 3; ++k)
-          ray[k] = depth_math::fog_bilerp<double>(c[kBottomLeft][k], c[kBottomRight][k], c[kTopLeft][k],
-                                                  c[kTopRight][k], u, v);
-        const double length = depth_math::fog_ray_length<double>(ray[0], ray[1], ray[2]);
+        const double length =
+            depth_math::fog_corner_ray_length(c, depth_math::fog_pixel_u<double>(x, inv_width), v);
         eye = eye * far_plane / length;  // non-finite / <= 0 stay so, and become sky below
       }
       d = float(raw_from_eye_depth(eye, camera));

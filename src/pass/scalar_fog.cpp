@@ -63,22 +63,15 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
     const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-      T ray_length = 0;
-      if (distance) {
-        const T u = fog_pixel_u(T(x), inv_width);
-        T ray[3];
-        for (int c = 0; c < 3; ++c)
-          ray[c] = fog_bilerp(T(cn[kBottomLeft][c]), T(cn[kBottomRight][c]), T(cn[kTopLeft][c]),
-                              T(cn[kTopRight][c]), u, vv);
-        ray_length = fog_ray_length(ray[0], ray[1], ray[2]);
+      const T ray_length = distance ? fog_corner_ray_length(cn, fog_pixel_u(T(x), inv_width), vv) : T(0);
+      T f = 1, amount = 0;
+      if (v.needs_pass()) {
+        int sky;
+        const T d = fog_view_distance(T(raw_depth[i]), ray_length, distance, reversed, projection, zx, zy,
+                                      near_plane, far_plane, &sky);
+        f = fog_factor_at(d, sky, mode, skybox, k.a, k.b);
+        if (with_amount) amount = fog_amount_at(d, sky, mode, skybox, k.a, k.b);
       }
-      const T f = v.needs_pass() ? fog_factor(T(raw_depth[i]), ray_length, mode, distance, skybox,
-                                              reversed, projection, zx, zy, near_plane, far_plane, k.a, k.b)
-                                 : T(1);
-      const T amount = with_amount && v.needs_pass()
-                           ? fog_amount(T(raw_depth[i]), ray_length, mode, distance, skybox, reversed,
-                                        projection, zx, zy, near_plane, far_plane, k.a, k.b)
-                           : T(0);
       const Channel* c = color + 4 * i;
       T rgba[4];
       for (int ch = 0; ch < 3; ++ch) rgba[ch] = fog_blend(T(load_channel(c + ch)), fog[ch], f);
