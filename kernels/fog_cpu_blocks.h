@@ -10,6 +10,17 @@
 typedef float fog_v16f __attribute__((__vector_size__(64)));
 typedef short fog_v16h __attribute__((__vector_size__(32), aligned(2)));
 #endif
+#ifdef __clang__
+/* 16 words at 4-byte alignment, moved by one unaligned vector instruction: PoCL lowers
+ * vstore16 to three stores (16 + 16 + 32 bytes) and splits vload16 of uint into four loads. */
+typedef float fog_v16f_u __attribute__((__vector_size__(64), aligned(4)));
+typedef uint fog_v16u_u __attribute__((__vector_size__(64), aligned(4)));
+#define FOG_STORE16(value, p) (*(global fog_v16f_u*)(p) = __builtin_bit_cast(fog_v16f_u, (value)))
+#define FOG_COPY16(from, to) (*(global fog_v16u_u*)(to) = *(global const fog_v16u_u*)(from))
+#else
+#define FOG_STORE16(value, p) vstore16((value), 0, (p))
+#define FOG_COPY16(from, to) vstore16(vload16(0, (from)), 0, (to))
+#endif
 
 /* Bit j set where lane j of f equals value. */
 static inline uint fog_lanes_equal(float16 f, float value) {
@@ -50,7 +61,7 @@ static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q) {
     return;
   }
 #endif
-  vstore16(value, q, p);
+  FOG_STORE16(value, p + 16 * q);
 #elif defined(FOG_AVX512)
   ((global fog_v16h*)p)[q] = __builtin_ia32_vcvtps2ph512_mask(
       __builtin_bit_cast(fog_v16f, value), 0 /* round to nearest even */, (fog_v16h){}, (ushort)0xffff);
@@ -99,7 +110,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   global uint* out_bits = (global uint*)out;
   const uint keep = fog_lanes_equal(f, 1.0f);
   if (keep == 0xffffu) {
-    for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16) vstore16(vload16(0, in_bits + w), 0, out_bits + w);
+    for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16) FOG_COPY16(in_bits + w, out_bits + w);
     return;
   }
   const float16 fog_rgba = (float16)(k->fog_color.xyz, 0.0f, k->fog_color.xyz, 0.0f,
