@@ -65,12 +65,24 @@ FOG_FN FOG_REAL FOG_NAME(fog_ray_length)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz) 
 #define FOG_IS_NAN(x) isnan(x)
 #endif
 
-/* Raw depth outside [0, 1] is clamped; NaN becomes the far value (sky). NaN is tested
- * explicitly: compilers turn fmin/fmax clamps into saturate instructions that send NaN to 0
- * (NVIDIA does), which would put a NaN pixel at the near plane. */
+/* Raw depth outside [0, 1] is clamped; NaN becomes the far value (sky). IEEE builds clamp by
+ * compare-and-select, towards the far end first: a comparison with NaN is false, so NaN takes
+ * the far value there, and the second select never sees a NaN (two min/max instructions on x86).
+ * Under -cl-fast-relaxed-math the compiler may assume no NaN and rewrite that clamp, so NaN is
+ * tested on its bits and replaced after an fmin/fmax clamp (compilers turn that clamp into
+ * saturate instructions, which send NaN to 0: NVIDIA does). */
 FOG_FN FOG_REAL FOG_NAME(fog_sanitize_depth)(FOG_REAL raw, int reversed_z) {
+#ifdef __FAST_RELAXED_MATH__
   FOG_REAL clamped = fmin(fmax(raw, (FOG_REAL)0), (FOG_REAL)1);
   return FOG_IS_NAN(raw) ? (FOG_REAL)(reversed_z ? 0.0f : 1.0f) : clamped;
+#else
+  if (reversed_z) {
+    FOG_REAL t = raw > (FOG_REAL)0 ? raw : (FOG_REAL)0;
+    return t < (FOG_REAL)1 ? t : (FOG_REAL)1;
+  }
+  FOG_REAL t = raw < (FOG_REAL)1 ? raw : (FOG_REAL)1;
+  return t > (FOG_REAL)0 ? t : (FOG_REAL)0;
+#endif
 }
 
 /* Linear01Depth = 1 / (x * raw + y), evaluated without cancellation. Conventional Z has
@@ -151,14 +163,14 @@ FOG_FN FOG_REAL FOG_NAME(fog_exp2_poly)(FOG_REAL x) {
 
 /* Exp: f = exp2(-d * density / ln 2) = e^(-density d); k = density * log2(e). */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_exp)(FOG_REAL d, FOG_REAL k) {
-  return FOG_EXP2(-(d * k)); /* in [0, 1]: no saturate */
+  return FOG_EXP2(d * -k); /* in [0, 1]: no saturate; -(d * k) with the sign on the constant */
 }
 
 /* Exp2: f = exp2(-(d * density / sqrt(ln 2))^2) = e^(-(density d)^2); k = density / sqrt(ln 2).
  * A huge d * k squares to +inf and exp2(-inf) = 0: no NaN. */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL d, FOG_REAL k) {
   FOG_REAL t = d * k;
-  return FOG_EXP2(-(t * t));
+  return FOG_EXP2(fma(-t, t, (FOG_REAL)0)); /* -(t * t) in one fused negative multiply */
 }
 
 /* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky. The int
