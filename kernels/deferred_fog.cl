@@ -61,6 +61,9 @@
 #ifndef FOG_EXP2
 #define FOG_EXP2 FOG_NAME(fog_exp2_poly)
 #endif
+#if FOG_VECTOR_WIDTH == 16
+#define FOG_CLAMP_BY_SELECT /* CPU devices: LLVM keeps IEEE comparisons (fog_sanitize_depth) */
+#endif
 
 #define FOG_REAL float
 #define FOG_INT int

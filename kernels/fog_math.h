@@ -65,23 +65,27 @@ FOG_FN FOG_REAL FOG_NAME(fog_ray_length)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz) 
 #define FOG_IS_NAN(x) isnan(x)
 #endif
 
-/* Raw depth outside [0, 1] is clamped; NaN becomes the far value (sky). IEEE builds clamp by
- * compare-and-select, towards the far end first: a comparison with NaN is false, so NaN takes
- * the far value there, and the second select never sees a NaN (two min/max instructions on x86).
- * Under -cl-fast-relaxed-math the compiler may assume no NaN and rewrite that clamp, so NaN is
- * tested on its bits and replaced after an fmin/fmax clamp (compilers turn that clamp into
- * saturate instructions, which send NaN to 0: NVIDIA does). */
+/* Raw depth outside [0, 1] is clamped; NaN becomes the far value (sky). Two implementations,
+ * the same results:
+ * - FOG_CLAMP_BY_SELECT (includers whose compiler keeps IEEE comparisons: LLVM on CPU devices,
+ *   C++): compare-and-select towards the far end first. A comparison with NaN is false, so NaN
+ *   takes the far value at the first select and the second never sees one; two min/max
+ *   instructions on x86.
+ * - otherwise, and always under -cl-fast-relaxed-math (which lets the compiler assume no NaN):
+ *   NaN is tested on its bits and replaced after an fmin/fmax clamp. NVIDIA's compiler turns a
+ *   clamp into a saturate, which sends NaN to 0 (the near plane), even the compare-and-select
+ *   form above: an H100 run of the suite caught both. */
 FOG_FN FOG_REAL FOG_NAME(fog_sanitize_depth)(FOG_REAL raw, int reversed_z) {
-#ifdef __FAST_RELAXED_MATH__
-  FOG_REAL clamped = fmin(fmax(raw, (FOG_REAL)0), (FOG_REAL)1);
-  return FOG_IS_NAN(raw) ? (FOG_REAL)(reversed_z ? 0.0f : 1.0f) : clamped;
-#else
+#if defined(FOG_CLAMP_BY_SELECT) && !defined(__FAST_RELAXED_MATH__)
   if (reversed_z) {
     FOG_REAL t = raw > (FOG_REAL)0 ? raw : (FOG_REAL)0;
     return t < (FOG_REAL)1 ? t : (FOG_REAL)1;
   }
   FOG_REAL t = raw < (FOG_REAL)1 ? raw : (FOG_REAL)1;
   return t > (FOG_REAL)0 ? t : (FOG_REAL)0;
+#else
+  FOG_REAL clamped = fmin(fmax(raw, (FOG_REAL)0), (FOG_REAL)1);
+  return FOG_IS_NAN(raw) ? (FOG_REAL)(reversed_z ? 0.0f : 1.0f) : clamped;
 #endif
 }
 

@@ -38,8 +38,10 @@ inline double fog_exp2(double x) { return std::exp2(std::fmin(x, 0.0)); }
 #define FOG_TO_REAL fog_to_real
 #define FOG_AS_REAL fog_as_real
 #define FOG_EXP2 fog_exp2
+#define FOG_CLAMP_BY_SELECT
 #include "fog_math.h"  // undefines the instance macros
 #undef FOG_EXP2
+#undef FOG_CLAMP_BY_SELECT
 
 inline float fog_exp2(float x) { return fog_exp2_poly(x); }
 
