@@ -42,11 +42,11 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
       const float* d = depth + std::size_t(y) * std::size_t(w);
 #pragma omp simd
       for (int x = 0; x < w; ++x) {
-        float ray_length = 0.0f;
+        float ray = 0.0f;
         if constexpr (kDistance) {
-          ray_length = fog_corner_ray_length(c, fog_pixel_u(float(x), inv_width), vv);
+          ray = fog_corner_ray_term(c, fog_pixel_u(float(x), inv_width), vv, FOG_SQUARED(kMode, 1));
         }
-        f[x] = fog_factor(d[x], ray_length, kMode, kDistance, kSkybox, kReversed, projection, zx, zy, near_plane,
+        f[x] = fog_factor(d[x], ray, kMode, kDistance, kSkybox, kReversed, projection, zx, zy, near_plane,
                           far_plane, k.a, k.b);
       }
       const Channel* ci = in + 4 * std::size_t(y) * std::size_t(w);

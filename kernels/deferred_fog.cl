@@ -122,14 +122,14 @@ static inline void fog_blend_pixel(global const COLOR_T* color_in, global COLOR_
 static inline void fog_pixel(global const COLOR_T* color_in, global const float* depth,
                              global COLOR_T* color_out, size_t i, int x, int y,
                              const FogConstants* k) {
-  float ray_length = 0.0f;
+  float ray = 0.0f;
 #if FOG_USE_DISTANCE
   const float u = fog_pixel_u((float)x, k->inv_width), v = fog_pixel_v((float)y, k->height);
-  ray_length = fog_ray_length(fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v),
-                              fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
-                              fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v));
+  ray = fog_ray_term(fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v),
+                     fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
+                     fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v), FOG_SQUARED(FOG_MODE, 1));
 #endif
-  const float f = fog_factor(depth[i], ray_length, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
+  const float f = fog_factor(depth[i], ray, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
                              FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx, k->zy, k->near_plane, k->far_plane,
                              k->k_a, k->k_b);
   fog_blend_pixel(color_in, color_out, i, f, k);

@@ -89,17 +89,18 @@ static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q) {
 static inline void fog_pixels16(global const COLOR_T* color_in, global const float* depth,
                                 global COLOR_T* color_out, size_t i0, int x0, int y,
                                 const FogConstants* k) {
-  float16 ray_length = 0.0f;
+  float16 ray = 0.0f;
 #if FOG_USE_DISTANCE
   const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   const float16 u = fog_pixel_u_v((float16)((float)x0) + lane, (float16)k->inv_width);
   const float16 v = (float16)fog_pixel_v((float)y, k->height);
-  ray_length = fog_ray_length_v(
+  ray = fog_ray_term_v(
       fog_bilerp_v((float16)k->bl.x, (float16)k->br.x, (float16)k->tl.x, (float16)k->tr.x, u, v),
       fog_bilerp_v((float16)k->bl.y, (float16)k->br.y, (float16)k->tl.y, (float16)k->tr.y, u, v),
-      fog_bilerp_v((float16)k->bl.z, (float16)k->br.z, (float16)k->tl.z, (float16)k->tr.z, u, v));
+      fog_bilerp_v((float16)k->bl.z, (float16)k->br.z, (float16)k->tl.z, (float16)k->tr.z, u, v),
+      FOG_SQUARED(FOG_MODE, 1));
 #endif
-  const float16 f = fog_factor_v(vload16(0, depth + i0), ray_length, FOG_MODE, FOG_USE_DISTANCE,
+  const float16 f = fog_factor_v(vload16(0, depth + i0), ray, FOG_MODE, FOG_USE_DISTANCE,
                                  FOG_USE_SKYBOX, FOG_USE_REVERSED_Z, FOG_PROJECTION, (float16)k->zx,
                                  (float16)k->zy, (float16)k->near_plane, (float16)k->far_plane,
                                  (float16)k->k_a, (float16)k->k_b);

@@ -30,6 +30,10 @@
 #define FOG_PROJECTION_PERSPECTIVE 0
 #define FOG_PROJECTION_INFINITE_FAR 1
 #define FOG_PROJECTION_ORTHOGRAPHIC 2
+/* Distance-based exp2 fog works on the squared view distance q = d^2, which it needs anyway, so
+ * it takes no square root of |ray|^2 (a vector sqrt costs the CPU path about 4 cycles per 16
+ * pixels). Everything else works on q = d. */
+#define FOG_SQUARED(mode, distance) ((mode) == FOG_MODE_EXP2 && (distance))
 #endif
 
 /* Pixel centre to Unity uv: u grows to the right, v grows upwards (row 0 is the top row).
@@ -53,8 +57,10 @@ FOG_FN FOG_REAL FOG_NAME(fog_bilerp)(FOG_REAL bl, FOG_REAL br, FOG_REAL tl, FOG_
   return fma(right - left, u, left);
 }
 
-FOG_FN FOG_REAL FOG_NAME(fog_ray_length)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz) {
-  return sqrt(fma(rx, rx, fma(ry, ry, rz * rz)));
+/* The ray term fog_view_distance takes: |ray|, or |ray|^2 where the mode squares (FOG_SQUARED). */
+FOG_FN FOG_REAL FOG_NAME(fog_ray_term)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz, int squared) {
+  FOG_REAL length2 = fma(rx, rx, fma(ry, ry, rz * rz));
+  return squared ? length2 : sqrt(length2);
 }
 
 /* NaN test that survives -cl-fast-relaxed-math (which may fold x != x away): the bit pattern.
@@ -171,69 +177,78 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_exp)(FOG_REAL d, FOG_REAL k) {
 }
 
 /* Exp2: f = exp2(-(d * density / sqrt(ln 2))^2) = e^(-(density d)^2); k = density / sqrt(ln 2).
- * A huge d * k squares to +inf and exp2(-inf) = 0: no NaN. */
-FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL d, FOG_REAL k) {
-  FOG_REAL t = d * k;
+ * q = d, or d^2 where `squared`. (d k)^2 and (q k) k grow monotonically to +inf and
+ * exp2(-inf) = 0: no NaN; q = d^2 itself overflows only beyond d = 1.8e19. */
+FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL q, FOG_REAL k, int squared) {
+  if (squared) return FOG_EXP2((q * k) * -k);
+  FOG_REAL t = q * k;
   return FOG_EXP2(fma(-t, t, (FOG_REAL)0)); /* -(t * t) in one fused negative multiply */
 }
 
-/* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky. The int
- * parameters are compile-time constants in the kernel, so the branches a variant does not use
- * fold away. ray_length = |ray(u, v)| is read only when distance-based (perspective only: with
- * parallel orthographic rays the host folds distance into depth). */
-FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray_length, int distance,
-                                            int reversed_z, int projection, FOG_REAL zx,
-                                            FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
-                                            FOG_INT* sky) {
+/* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky: q = d, or d^2
+ * where `squared` (FOG_SQUARED: distance-based exp2). The int parameters are compile-time constants in the
+ * kernel, so the branches a variant does not use fold away. ray = fog_ray_term (|ray(u, v)|, or
+ * its square) is read only when distance-based (perspective only: with parallel orthographic rays
+ * the host folds distance into depth). */
+FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray, int distance,
+                                            int reversed_z, int projection, int squared,
+                                            FOG_REAL zx, FOG_REAL zy, FOG_REAL near_plane,
+                                            FOG_REAL far_plane, FOG_INT* sky) {
   FOG_REAL depth = FOG_NAME(fog_sanitize_depth)(raw, reversed_z);
+  /* scale * |ray| is the distance-based d; the depth-based d has no ray. */
+  FOG_REAL scale, d;
   if (projection == FOG_PROJECTION_INFINITE_FAR) {
     /* Depth 0 is infinitely far: sky, decided on the raw value before any arithmetic. */
     *sky = depth == (FOG_REAL)0;
-    FOG_REAL eye = FOG_NAME(fog_eye_depth_infinite)(depth, near_plane);
-    return distance ? eye * ray_length : eye - near_plane;
+    scale = FOG_NAME(fog_eye_depth_infinite)(depth, near_plane);
+    d = scale - near_plane;
+  } else {
+    scale = projection == FOG_PROJECTION_ORTHOGRAPHIC
+                ? FOG_NAME(fog_linear01_depth_ortho)(depth, zx, zy)
+                : FOG_NAME(fog_linear01_depth)(depth, zx, zy, reversed_z);
+    *sky = FOG_NAME(fog_is_sky)(scale);
+    d = FOG_NAME(fog_depth_distance)(scale, near_plane, far_plane);
   }
-  FOG_REAL linear01 = projection == FOG_PROJECTION_ORTHOGRAPHIC
-                          ? FOG_NAME(fog_linear01_depth_ortho)(depth, zx, zy)
-                          : FOG_NAME(fog_linear01_depth)(depth, zx, zy, reversed_z);
-  *sky = FOG_NAME(fog_is_sky)(linear01);
-  return distance ? linear01 * ray_length
-                  : FOG_NAME(fog_depth_distance)(linear01, near_plane, far_plane);
+  if (distance) return squared ? (scale * scale) * ray : scale * ray;
+  return d;
 }
 
-/* The fog factor f at view distance d (fog_view_distance, which also says whether the pixel is
- * sky). k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k, density). */
-FOG_FN FOG_REAL FOG_NAME(fog_factor_at)(FOG_REAL d, FOG_INT sky, int mode, int fog_skybox,
-                                        FOG_REAL k_a, FOG_REAL k_b) {
-  FOG_REAL f = mode == FOG_MODE_LINEAR ? FOG_NAME(fog_factor_linear)(d, k_a, k_b)
-             : mode == FOG_MODE_STEP   ? FOG_NAME(fog_factor_step)(d, k_a)
-             : mode == FOG_MODE_EXP    ? FOG_NAME(fog_factor_exp)(d, k_a)
-                                       : FOG_NAME(fog_factor_exp2)(d, k_a);
+/* The fog factor f at view distance q (fog_view_distance: d, or d^2 for exp2; it also says whether
+ * the pixel is sky). k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k,
+ * density). */
+FOG_FN FOG_REAL FOG_NAME(fog_factor_at)(FOG_REAL q, FOG_INT sky, int mode, int squared,
+                                        int fog_skybox, FOG_REAL k_a, FOG_REAL k_b) {
+  FOG_REAL f = mode == FOG_MODE_LINEAR ? FOG_NAME(fog_factor_linear)(q, k_a, k_b)
+             : mode == FOG_MODE_STEP   ? FOG_NAME(fog_factor_step)(q, k_a)
+             : mode == FOG_MODE_EXP    ? FOG_NAME(fog_factor_exp)(q, k_a)
+                                       : FOG_NAME(fog_factor_exp2)(q, k_a, squared);
   return fog_skybox ? f : (sky ? (FOG_REAL)1 : f);
 }
 
-/* The fog amount 1 - f at view distance d, without the cancellation of computing 1 - f when f
- * is close to 1: exp: -expm1(-density d); exp2: -expm1(-(density d)^2). Linear and step: 1 - f
- * (exact where it matters: f is then far from 1 or exactly 0 / 1). Reported by the scalar path
- * (FogResult). */
-FOG_FN FOG_REAL FOG_NAME(fog_amount_at)(FOG_REAL d, FOG_INT sky, int mode, int fog_skybox,
-                                        FOG_REAL k_a, FOG_REAL k_b) {
-  FOG_REAL x = d * k_b; /* exp / exp2: density * d */
-  FOG_REAL a = mode == FOG_MODE_LINEAR ? (FOG_REAL)1 - FOG_NAME(fog_factor_linear)(d, k_a, k_b)
-             : mode == FOG_MODE_STEP   ? (FOG_REAL)1 - FOG_NAME(fog_factor_step)(d, k_a)
+/* The fog amount 1 - f at view distance q (as fog_factor_at), without the cancellation of
+ * computing 1 - f when f is close to 1: exp: -expm1(-density d); exp2: -expm1(-(density d)^2).
+ * Linear and step: 1 - f (exact where it matters: f is then far from 1 or exactly 0 / 1).
+ * Reported by the scalar path (FogResult). */
+FOG_FN FOG_REAL FOG_NAME(fog_amount_at)(FOG_REAL q, FOG_INT sky, int mode, int squared,
+                                        int fog_skybox, FOG_REAL k_a, FOG_REAL k_b) {
+  FOG_REAL x = q * k_b; /* exp / exp2: density * d, or density * d^2 where squared */
+  FOG_REAL a = mode == FOG_MODE_LINEAR ? (FOG_REAL)1 - FOG_NAME(fog_factor_linear)(q, k_a, k_b)
+             : mode == FOG_MODE_STEP   ? (FOG_REAL)1 - FOG_NAME(fog_factor_step)(q, k_a)
              : mode == FOG_MODE_EXP    ? -expm1(-x)
-                                       : -expm1(-(x * x));
+                                       : -expm1(-(squared ? x * k_b : x * x));
   return fog_skybox ? FOG_NAME(fog_saturate)(a) : (sky ? (FOG_REAL)0 : FOG_NAME(fog_saturate)(a));
 }
 
 /* The fog factor f of a pixel from its raw depth: the whole chain of DESIGN.md §2. */
-FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray_length, int mode, int distance,
+FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray, int mode, int distance,
                                      int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
                                      FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
                                      FOG_REAL k_a, FOG_REAL k_b) {
   FOG_INT sky;
-  FOG_REAL d = FOG_NAME(fog_view_distance)(raw, ray_length, distance, reversed_z, projection, zx,
-                                           zy, near_plane, far_plane, &sky);
-  return FOG_NAME(fog_factor_at)(d, sky, mode, fog_skybox, k_a, k_b);
+  int squared = FOG_SQUARED(mode, distance);
+  FOG_REAL q = FOG_NAME(fog_view_distance)(raw, ray, distance, reversed_z, projection, squared,
+                                           zx, zy, near_plane, far_plane, &sky);
+  return FOG_NAME(fog_factor_at)(q, sky, mode, squared, fog_skybox, k_a, k_b);
 }
 
 /* Blend one channel: fogColor + f * (c - fogColor). f == 1 returns c untouched (bit-exact, NaN

@@ -48,7 +48,7 @@ void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera)
       double eye = double(d);
       if (kind == DepthKind::distance) {
         const double length =
-            depth_math::fog_corner_ray_length(c, depth_math::fog_pixel_u<double>(x, inv_width), v);
+            depth_math::fog_corner_ray_term(c, depth_math::fog_pixel_u<double>(x, inv_width), v, /*squared=*/0);
         eye = eye * far_plane / length;  // non-finite / <= 0 stay so, and become sky below
       }
       d = float(raw_from_eye_depth(eye, camera));

@@ -45,15 +45,17 @@ inline double fog_exp2(double x) { return std::exp2(std::fmin(x, 0.0)); }
 
 inline float fog_exp2(float x) { return fog_exp2_poly(x); }
 
-// |ray(u, v)| of a pixel: each component interpolated from the frustum corners (fog_bilerp),
-// then fog_ray_length. The kernel composes the same formulas on its vector types. Always
-// inlined: it sits in per-pixel loops that are vectorised or compiled for FMA (scalar_fog.cpp).
+// The ray term of a pixel (fog_ray_term: |ray(u, v)|, or its square where `squared`): each
+// component interpolated from the frustum corners (fog_bilerp). The kernel composes the same
+// formulas on its vector types. Always inlined: it sits in per-pixel loops that are vectorised or
+// compiled for FMA (scalar_fog.cpp).
 template <class T>
-[[gnu::always_inline]] inline T fog_corner_ray_length(const std::array<glm::vec3, 4>& corners, T u, T v) {
+[[gnu::always_inline]] inline T fog_corner_ray_term(const std::array<glm::vec3, 4>& corners, T u, T v,
+                                                    int squared) {
   T ray[3];
   for (int k = 0; k < 3; ++k)
     ray[k] = fog_bilerp(T(corners[kBottomLeft][k]), T(corners[kBottomRight][k]), T(corners[kTopLeft][k]),
                         T(corners[kTopRight][k]), u, v);
-  return fog_ray_length(ray[0], ray[1], ray[2]);
+  return fog_ray_term(ray[0], ray[1], ray[2], squared);
 }
 }  // namespace fogcl::formulas

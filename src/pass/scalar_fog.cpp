@@ -57,20 +57,20 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
   const auto& cn = cam.frustum_corners;
   const float* raw_depth = depth.data();
   const int mode = int(v.mode), distance = v.distance, skybox = v.fog_skybox, reversed = v.reversed_z;
-  const int projection = int(v.projection);
+  const int projection = int(v.projection), squared = FOG_SQUARED(mode, distance);
   const T inv_width = T(1) / T(w);
   for (int y = 0; y < h; ++y) {
     const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-      const T ray_length = distance ? fog_corner_ray_length(cn, fog_pixel_u(T(x), inv_width), vv) : T(0);
+      const T ray = distance ? fog_corner_ray_term(cn, fog_pixel_u(T(x), inv_width), vv, squared) : T(0);
       T f = 1, amount = 0;
       if (v.needs_pass()) {
         int sky;
-        const T d = fog_view_distance(T(raw_depth[i]), ray_length, distance, reversed, projection, zx, zy,
-                                      near_plane, far_plane, &sky);
-        f = fog_factor_at(d, sky, mode, skybox, k.a, k.b);
-        if (with_amount) amount = fog_amount_at(d, sky, mode, skybox, k.a, k.b);
+        const T q = fog_view_distance(T(raw_depth[i]), ray, distance, reversed, projection, squared, zx,
+                                      zy, near_plane, far_plane, &sky);
+        f = fog_factor_at(q, sky, mode, squared, skybox, k.a, k.b);
+        if (with_amount) amount = fog_amount_at(q, sky, mode, squared, skybox, k.a, k.b);
       }
       const Channel* c = color + 4 * i;
       T rgba[4];
