@@ -8,6 +8,9 @@
 #include <utility>
 
 #include <Imath/half.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "fogcl/error.h"
 
@@ -15,6 +18,11 @@ namespace fogcl {
 
 namespace {
 constexpr std::size_t kAlignment = 4096;  // page: satisfies every device's CL_DEVICE_MEM_BASE_ADDR_ALIGN
+// Frames of 2 MiB and more sit on 2 MiB boundaries and ask Linux for transparent huge pages: a
+// 1080p RGBA32F frame is then 16 page faults instead of 8100 (on a VM, 80 ms of a warm start's
+// 200 ms to the first frame was faulting in the output), and 16 TLB entries when the pass
+// streams through it.
+constexpr std::size_t kHugePage = std::size_t(2) << 20;
 
 void check_size(const char* what, int width, int height) {
   if (width < 1 || height < 1)
@@ -35,9 +43,13 @@ namespace detail {
 void AlignedBytes::Free::operator()(std::byte* p) const { std::free(p); }
 
 AlignedBytes::AlignedBytes(std::size_t size) : size_(size) {
-  const std::size_t rounded = (size + kAlignment - 1) / kAlignment * kAlignment;
-  auto* p = static_cast<std::byte*>(std::aligned_alloc(kAlignment, rounded == 0 ? kAlignment : rounded));
+  const std::size_t alignment = size >= kHugePage ? kHugePage : kAlignment;
+  const std::size_t rounded = (size + alignment - 1) / alignment * alignment;
+  auto* p = static_cast<std::byte*>(std::aligned_alloc(alignment, rounded == 0 ? alignment : rounded));
   if (p == nullptr) throw std::bad_alloc();
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  if (alignment == kHugePage) madvise(p, rounded, MADV_HUGEPAGE);  // advice only: failure is harmless
+#endif
   std::memset(p, 0, rounded);
   data_.reset(p);
 }
