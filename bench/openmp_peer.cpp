@@ -44,7 +44,7 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
       for (int x = 0; x < w; ++x) {
         float ray = 0.0f;
         if constexpr (kDistance) {
-          ray = fog_corner_ray_term(c, fog_pixel_u(float(x), inv_width), vv, FOG_SQUARED(kMode, 1));
+          ray = fog_corner_ray_term(c, fog_pixel_u(float(x), inv_width), vv, FOG_SQUARED(kMode, kDistance));
         }
         f[x] = fog_factor(d[x], ray, kMode, kDistance, kSkybox, kReversed, projection, zx, zy, near_plane,
                           far_plane, k.a, k.b);

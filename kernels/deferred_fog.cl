@@ -3,7 +3,8 @@
  * Variant switches, set by the host's build_options(); a variant holds no code for a feature the
  * scene does not use:
  *   FOG_MODE          1 linear, 2 linear hard step (start == end), 3 exp, 4 exp2
- *   FOG_DISTANCE      distance-based fog (corner interpolation and a sqrt); else depth-based
+ *   FOG_DISTANCE      distance-based fog (corner interpolation, and a sqrt but for exp2); else
+ *                     depth-based
  *   FOG_SKYBOX        fog the skybox too (no sky test); else sky pixels keep f = 1
  *   REVERSED_Z        depth 1 at near, 0 at far (decides where a NaN depth lands: the far end)
  *   FOG_PROJECTION    0 perspective (default), 1 reversed-Z infinite far, 2 orthographic
@@ -64,6 +65,8 @@
 #if FOG_VECTOR_WIDTH == 16
 #define FOG_CLAMP_BY_SELECT /* CPU devices: LLVM keeps IEEE comparisons (fog_sanitize_depth) */
 #endif
+/* What the ray term is: |ray|, or |ray|^2 for distance-based exp2 (fog_math.h, FOG_SQUARED). */
+#define FOG_USE_SQUARED FOG_SQUARED(FOG_MODE, FOG_USE_DISTANCE)
 
 #define FOG_REAL float
 #define FOG_INT int
@@ -127,7 +130,7 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
   const float u = fog_pixel_u((float)x, k->inv_width), v = fog_pixel_v((float)y, k->height);
   ray = fog_ray_term(fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v),
                      fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
-                     fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v), FOG_SQUARED(FOG_MODE, 1));
+                     fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v), FOG_USE_SQUARED);
 #endif
   const float f = fog_factor(depth[i], ray, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
                              FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx, k->zy, k->near_plane, k->far_plane,

@@ -98,7 +98,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
       fog_bilerp_v((float16)k->bl.x, (float16)k->br.x, (float16)k->tl.x, (float16)k->tr.x, u, v),
       fog_bilerp_v((float16)k->bl.y, (float16)k->br.y, (float16)k->tl.y, (float16)k->tr.y, u, v),
       fog_bilerp_v((float16)k->bl.z, (float16)k->br.z, (float16)k->tl.z, (float16)k->tr.z, u, v),
-      FOG_SQUARED(FOG_MODE, 1));
+      FOG_USE_SQUARED);
 #endif
   const float16 f = fog_factor_v(vload16(0, depth + i0), ray, FOG_MODE, FOG_USE_DISTANCE,
                                  FOG_USE_SKYBOX, FOG_USE_REVERSED_Z, FOG_PROJECTION, (float16)k->zx,
@@ -150,3 +150,6 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
 }
 #undef FOG_QUAD_FACTORS
 #undef FOG_ALPHA_LANES
+#undef FOG_STORE16
+#undef FOG_COPY16
+#undef FOG_AVX512

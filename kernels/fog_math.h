@@ -57,7 +57,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_bilerp)(FOG_REAL bl, FOG_REAL br, FOG_REAL tl, FOG_
   return fma(right - left, u, left);
 }
 
-/* The ray term fog_view_distance takes: |ray|, or |ray|^2 where the mode squares (FOG_SQUARED). */
+/* The ray term fog_view_distance takes: |ray|, or |ray|^2 where `squared` (FOG_SQUARED). */
 FOG_FN FOG_REAL FOG_NAME(fog_ray_term)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz, int squared) {
   FOG_REAL length2 = fma(rx, rx, fma(ry, ry, rz * rz));
   return squared ? length2 : sqrt(length2);
@@ -186,10 +186,10 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL q, FOG_REAL k, int squared) {
 }
 
 /* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky: q = d, or d^2
- * where `squared` (FOG_SQUARED: distance-based exp2). The int parameters are compile-time constants in the
- * kernel, so the branches a variant does not use fold away. ray = fog_ray_term (|ray(u, v)|, or
- * its square) is read only when distance-based (perspective only: with parallel orthographic rays
- * the host folds distance into depth). */
+ * where `squared` (FOG_SQUARED: distance-based exp2). The int parameters are compile-time
+ * constants in the kernel, so the branches a variant does not use fold away. ray = fog_ray_term
+ * (|ray(u, v)|, or its square) is read only when distance-based (perspective only: with parallel
+ * orthographic rays the host folds distance into depth). */
 FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray, int distance,
                                             int reversed_z, int projection, int squared,
                                             FOG_REAL zx, FOG_REAL zy, FOG_REAL near_plane,
@@ -213,8 +213,8 @@ FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray, int dist
   return d;
 }
 
-/* The fog factor f at view distance q (fog_view_distance: d, or d^2 for exp2; it also says whether
- * the pixel is sky). k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k,
+/* The fog factor f at view distance q (fog_view_distance: d, or d^2 where squared; it also says
+ * whether the pixel is sky). k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k,
  * density). */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_at)(FOG_REAL q, FOG_INT sky, int mode, int squared,
                                         int fog_skybox, FOG_REAL k_a, FOG_REAL k_b) {
