@@ -13,7 +13,7 @@
  *                     -cl-fast-relaxed-math)
  *   FOG_VECTOR_WIDTH  pixels per work-item: 16 on CPU devices, 1 elsewhere.
  *   FOG_STREAMING_STORES  non-temporal stores of RGBA32F blocks (CPU devices)
- *   FOG_PORTABLE      CPU devices: OpenCL C only, no target builtins (fog_cpu_blocks.h)
+ *   FOG_PORTABLE      CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
  *
  * Why 16 pixels per work-item on CPUs: PoCL vectorises only across work-items, and a library
  * exp2 blocks that. Explicit float16 arithmetic maps straight onto SIMD registers, one lane per
@@ -77,12 +77,19 @@
 #define FOG_NAME(name) name
 #include "fog_math.h" /* undefines the instance macros above */
 
+#if FOG_VECTOR_WIDTH == 16
+#include "fog_cpu_avx512.h"
+#endif
 #define FOG_REAL float16
 #define FOG_INT int16
 #define FOG_AS_UINT as_uint16
 #define FOG_TRUNC_INT convert_int16
 #define FOG_TO_REAL convert_float16
 #define FOG_AS_REAL as_float16
+#ifdef FOG_AVX512
+#define FOG_CEIL fog_ceil_avx512
+#define FOG_EXP2_LDEXP fog_exp2_ldexp_avx512
+#endif
 #define FOG_NAME(name) name##_v
 #include "fog_math.h" /* undefines the instance macros above */
 

@@ -1,15 +1,9 @@
 /* fog_cpu_blocks.h — the CPU devices' path of deferred_fog.cl (FOG_VECTOR_WIDTH 16): 16 pixels
  * of a row per work-item, as float16 lanes, and the four per-block blends. Included by
- * deferred_fog.cl after the formula instances and FogConstants; needs COLOR_T. */
-
-#if defined(__clang__) && defined(__AVX512F__) && !defined(FOG_PORTABLE)
-/* x86 AVX-512 (PoCL on such CPUs): compares straight into mask registers and 16-wide half
- * conversions. The portable fallbacks below compile everywhere; LLVM splits their half
- * conversions into 8-wide halves and their lane reductions into scalar chains. */
-#define FOG_AVX512 1
-typedef float fog_v16f __attribute__((__vector_size__(64)));
-typedef short fog_v16h __attribute__((__vector_size__(32), aligned(2)));
-#endif
+ * deferred_fog.cl after the formula instances and FogConstants; needs COLOR_T and
+ * fog_cpu_avx512.h. Under FOG_AVX512 (x86 AVX-512) compares go straight into mask registers and
+ * half conversions are 16 wide; the portable fallbacks compile everywhere, but LLVM splits their
+ * half conversions into 8-wide halves and their lane reductions into scalar chains. */
 #ifdef __clang__
 /* 16 words at 4-byte alignment, moved by one unaligned vector instruction: PoCL lowers
  * vstore16 to three stores (16 + 16 + 32 bytes) and splits vload16 of uint into four loads. */

@@ -6,10 +6,11 @@
  *   - C++ (src/pass/scalar_fog.cpp): FOG_FN makes each function a template on FOG_REAL, so the
  *     same text runs in float for the baseline and in double for the reference.
  * The includer defines FOG_INT, FOG_NAME and the hooks of fog_exp2_poly (FOG_EXP2, FOG_TRUNC_INT,
- * FOG_TO_REAL, FOG_AS_REAL), plus FOG_REAL and FOG_AS_UINT in OpenCL C; this file has no include
- * guard on purpose and undefines those instance macros (not FOG_EXP2) at its end. Only
- * operations that exist in both languages appear: + - * /, fma, expm1, sqrt, fmin, fmax, integer
- * + and <<, a float -> int conversion, and ?: (a per-lane select on vectors in OpenCL C).
+ * FOG_TO_REAL, FOG_AS_REAL; optionally FOG_CEIL and FOG_EXP2_LDEXP), plus FOG_REAL and
+ * FOG_AS_UINT in OpenCL C; this file has no include guard on purpose and undefines those
+ * instance macros (not FOG_EXP2) at its end. Only operations that exist in both languages
+ * appear: + - * /, fma, expm1, sqrt, fmin, fmax, integer + and <<, a float -> int conversion, and
+ * ?: (a per-lane select on vectors in OpenCL C), besides the optional hooks.
  * Sources: Unity's UnityCG.cginc (Linear01Depth, UNITY_CALC_FOG_FACTOR_RAW) and Catlike Coding,
  * "Rendering 14: Fog" (deferred fog, depth vs distance, the skybox test). */
 
@@ -139,36 +140,49 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_step)(FOG_REAL d, FOG_REAL start) {
   return d < start ? (FOG_REAL)1 : (FOG_REAL)0;
 }
 
-/* 2^min(x, 0), the fog factors' exp2: in [0, 1] for every x, so callers need no saturate.
- * Cody-Waite split x = n + r, n integer, |r| <= 1/2, and a degree-6 polynomial for 2^r: the
- * Chebyshev fit of 2^r on [-1/2, 1/2] (scripts/exp2_coefficients.py), rounded to float, with
- * p(0) = 1 exactly. Results below 2^-126 are flushed to 0 — a denormal factor changes no color,
- * and computing one costs microcode assists on x86. Worst error over every float in [-126, 0]:
- * 0.992 ulp (full sweep; tests/exp2_test.cpp checks every 16th float). n comes from a float ->
- * int conversion, not from the add-and-subtract-1.5*2^23 trick, which fast-math reassociation
- * folds away, nor from a round-to-nearest conversion, a 20-instruction library routine in PoCL.
- * Vendor exp2 routines are library calls on CPU OpenCL devices; this is 16 vector instructions.
- * Includers reach it through FOG_EXP2 (every float path; the double reference keeps the C
- * library's exp2) and define FOG_TRUNC_INT (FOG_REAL to FOG_INT rounding toward zero: C's
- * cast), FOG_TO_REAL (FOG_INT to FOG_REAL) and FOG_AS_REAL (bit cast). */
-FOG_FN FOG_REAL FOG_NAME(fog_exp2_poly)(FOG_REAL x) {
-  /* Clamped to [-126, 0] by compare-and-select in min/max operand order (one instruction each
-   * on x86; x is never NaN here). */
-  FOG_REAL xc = (FOG_REAL)0 < x ? (FOG_REAL)0 : x;
-  xc = (FOG_REAL)-126 > xc ? (FOG_REAL)-126 : xc;
-  /* n = ceil(xc - 1/2) by truncation (xc - 1/2 < 0), one conversion instruction; the rounding
-   * of xc - 1/2 can put r a rounding error past +-1/2, where the fit still holds. */
-  FOG_INT n = FOG_TRUNC_INT(xc - (FOG_REAL)0.5f);
-  FOG_REAL r = xc - FOG_TO_REAL(n);
+/* 2^r for |r| <= 1/2 (a rounding error more is fine): the Chebyshev fit of degree 6
+ * (scripts/exp2_coefficients.py), rounded to float, with p(0) = 1 exactly. */
+FOG_FN FOG_REAL FOG_NAME(fog_exp2_reduced)(FOG_REAL r) {
   FOG_REAL p = (FOG_REAL)0x1.444p-13f;
   p = fma(p, r, (FOG_REAL)0x1.5f48cp-10f);
   p = fma(p, r, (FOG_REAL)0x1.3b2a1cp-7f);
   p = fma(p, r, (FOG_REAL)0x1.c6aeccp-5f);
   p = fma(p, r, (FOG_REAL)0x1.ebfbep-3f);
   p = fma(p, r, (FOG_REAL)0x1.62e43p-1f);
-  p = fma(p, r, (FOG_REAL)1);
+  return fma(p, r, (FOG_REAL)1);
+}
+
+/* 2^min(x, 0), the fog factors' exp2: in [0, 1] for every x, so callers need no saturate.
+ * Cody-Waite split x = n + r, n = ceil(x - 1/2) an integer, |r| <= 1/2, and 2^r from
+ * fog_exp2_reduced. Results below 2^-126 are flushed to 0 — a denormal factor changes no color,
+ * and computing one costs microcode assists on x86. Worst error over every float in [-126, 0]:
+ * 0.992 ulp (full sweep; tests/exp2_test.cpp checks every 16th float). n comes from a float ->
+ * int conversion, not from the add-and-subtract-1.5*2^23 trick, which fast-math reassociation
+ * folds away, nor from a round-to-nearest conversion, a 20-instruction library routine in PoCL.
+ * Vendor exp2 routines are library calls on CPU OpenCL devices; this is 16 vector instructions,
+ * 12 with the FOG_EXP2_LDEXP hooks. Includers reach it through FOG_EXP2 (every float path; the
+ * double reference keeps the C library's exp2) and define FOG_TRUNC_INT (FOG_REAL to FOG_INT
+ * rounding toward zero: C's cast), FOG_TO_REAL (FOG_INT to FOG_REAL) and FOG_AS_REAL (bit cast);
+ * optionally FOG_CEIL (round up, on FOG_REAL) with FOG_EXP2_LDEXP(p, n, x) (p * 2^n where
+ * x >= -126, else 0), which give the same bits. */
+FOG_FN FOG_REAL FOG_NAME(fog_exp2_poly)(FOG_REAL x) {
+  /* min(x, 0) by compare-and-select in minps operand order (one instruction on x86; x is never
+   * NaN here). */
+  FOG_REAL xc = (FOG_REAL)0 < x ? (FOG_REAL)0 : x;
+#ifdef FOG_EXP2_LDEXP
+  /* n stays a real and scales p in one instruction whose zero mask is the flush; lanes below
+   * -126 are discarded by that mask, so they need no clamp. */
+  FOG_REAL n = FOG_CEIL(xc - (FOG_REAL)0.5f);
+  return FOG_EXP2_LDEXP(FOG_NAME(fog_exp2_reduced)(xc - n), n, x);
+#else
+  xc = (FOG_REAL)-126 > xc ? (FOG_REAL)-126 : xc;
+  /* n = ceil(xc - 1/2) by truncation (xc - 1/2 < 0), one conversion instruction; the rounding
+   * of xc - 1/2 can put r a rounding error past +-1/2, where the fit still holds. */
+  FOG_INT n = FOG_TRUNC_INT(xc - (FOG_REAL)0.5f);
+  FOG_REAL p = FOG_NAME(fog_exp2_reduced)(xc - FOG_TO_REAL(n));
   FOG_REAL scale = FOG_AS_REAL((n + 127) << 23); /* 2^n, n in [-126, 0] */
   return x < (FOG_REAL)-126 ? (FOG_REAL)0 : p * scale;
+#endif
 }
 
 /* Exp: f = exp2(-d * density / ln 2) = e^(-density d); k = density * log2(e). */
@@ -270,4 +284,6 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
 #undef FOG_TRUNC_INT
 #undef FOG_TO_REAL
 #undef FOG_AS_REAL
+#undef FOG_CEIL
+#undef FOG_EXP2_LDEXP
 #undef FOG_NAME

@@ -1,0 +1,30 @@
+/* fog_cpu_avx512.h — x86 AVX-512 target builtins of the CPU devices' path (FOG_VECTOR_WIDTH 16),
+ * for PoCL compiling for such a CPU. Each has a portable OpenCL C counterpart that writes the same
+ * bytes (CpuCodegen::target_intrinsics = false defines FOG_PORTABLE; tests/cpu_block_paths_test
+ * and tests/kernel_factor_bits_test compare the two). Included by deferred_fog.cl before the
+ * float16 instance of fog_math.h, whose exp2 hooks are defined here; fog_cpu_blocks.h uses the
+ * rest. */
+#if defined(__clang__) && defined(__AVX512F__) && !defined(FOG_PORTABLE)
+#define FOG_AVX512 1
+typedef float fog_v16f __attribute__((__vector_size__(64)));
+typedef short fog_v16h __attribute__((__vector_size__(32), aligned(2)));
+
+/* Lanes rounded up to an integer: one vrndscaleps (PoCL's ceil is a 12-instruction routine). */
+static inline float16 fog_ceil_avx512(float16 x) {
+  return __builtin_bit_cast(float16, __builtin_ia32_rndscaleps_mask(
+      __builtin_bit_cast(fog_v16f, x), 0x0a /* round up, no precision exception */,
+      (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
+}
+
+/* p * 2^n where x >= -126, else 0: one vscalefps under a zero mask. n is an integer in
+ * [-126, 0] wherever x >= -126, so p * 2^n is exact there, as the portable path's multiply by the
+ * bits of 2^n is; the masked lanes may hold anything (x = -inf makes them NaN). */
+static inline float16 fog_exp2_ldexp_avx512(float16 p, float16 n, float16 x) {
+  const ushort in_range = __builtin_ia32_cmpps512_mask(
+      __builtin_bit_cast(fog_v16f, x), __builtin_bit_cast(fog_v16f, (float16)-126.0f),
+      0x1d /* _CMP_GE_OQ */, (ushort)0xffff, 4 /* current rounding */);
+  return __builtin_bit_cast(float16, __builtin_ia32_scalefps512_mask(
+      __builtin_bit_cast(fog_v16f, p), __builtin_bit_cast(fog_v16f, n), (fog_v16f){}, in_range,
+      4 /* current rounding */));
+}
+#endif
