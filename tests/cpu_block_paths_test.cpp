@@ -22,7 +22,7 @@ struct BlockCase {
 
 std::string name_of(const testing::TestParamInfo<BlockCase>& info) {
   const BlockCase& c = info.param;
-  std::string n = c.mode == FogMode::linear ? "linear" : c.mode == FogMode::exp ? "exp" : "exp2";
+  std::string n = to_string(c.mode);
   n += c.metric == FogMetric::distance ? "_distance" : "_depth";
   n += c.skybox ? "_skybox" : "_skytest";
   n += c.reversed ? "_reversed" : "_conventional";

@@ -22,7 +22,7 @@ struct FactorCase {
 
 std::string name_of(const testing::TestParamInfo<FactorCase>& info) {
   const FactorCase& c = info.param;
-  std::string n = c.mode == FogMode::linear ? "linear" : c.mode == FogMode::exp ? "exp" : "exp2";
+  std::string n = to_string(c.mode);
   n += c.metric == FogMetric::distance ? "_distance" : "_depth";
   n += c.reversed ? "_reversed" : "_conventional";
   n += "_reach" + std::to_string(int(c.reach * 100));
