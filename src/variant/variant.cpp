@@ -35,16 +35,20 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
 
 int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }
 
-std::string build_options(const Variant& v, const DeviceTraits& device) {
-  if (!v.needs_pass()) throw Error("build_options: the variant needs no kernel (fog is off)");
+std::string cl_std_option(const DeviceTraits& device) {
   const std::string& version = device.opencl_c_version;
   int major = 0, minor = 0;
   if (std::sscanf(version.c_str(), "OpenCL C %d.%d", &major, &minor) != 2)
     throw Error("device reports an unreadable OpenCL C version '" + version + "'");
   if (major * 10 + minor < 11)
     throw Error("device OpenCL C version " + version + " is older than 1.1");
-  // The kernel uses nothing past OpenCL C 1.2; ask for the newest of 1.1 / 1.2 the device has.
-  std::string o = major * 10 + minor >= 12 ? "-cl-std=CL1.2" : "-cl-std=CL1.1";
+  // The kernels use nothing past OpenCL C 1.2; ask for the newest of 1.1 / 1.2 the device has.
+  return major * 10 + minor >= 12 ? "-cl-std=CL1.2" : "-cl-std=CL1.1";
+}
+
+std::string build_options(const Variant& v, const DeviceTraits& device) {
+  if (!v.needs_pass()) throw Error("build_options: the variant needs no kernel (fog is off)");
+  std::string o = cl_std_option(device);
   o += " -D FOG_MODE=" + std::to_string(int(v.mode));
   if (v.distance) o += " -D FOG_DISTANCE";
   if (v.fog_skybox) o += " -D FOG_SKYBOX";

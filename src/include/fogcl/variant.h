@@ -66,6 +66,10 @@ int pixels_per_work_item(const DeviceTraits& device);
 // inputs give equal strings, so the string is the program cache key.
 std::string build_options(const Variant& variant, const DeviceTraits& device = {});
 
+// "-cl-std=CL1.2" (or CL1.1): the newest OpenCL C the kernels need that the device has. Throws
+// fogcl::Error for an unreadable or older version.
+std::string cl_std_option(const DeviceTraits& device);
+
 // Human-readable, e.g. "exp2 depth sky-test conventional-z rgba32f precise".
 std::string describe(const Variant& variant);
 

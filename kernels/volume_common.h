@@ -1,0 +1,109 @@
+/* volume_common.h — what every header of the volumetric pass shares (docs/volumetric.md): the
+ * language bridge and the layouts of the two parameter arrays the host packs.
+ *
+ * The volume headers are written once and compiled two ways, like fog_math.h:
+ *   - OpenCL C, one pixel per work-item: VOL_REAL float, VOL_V3 float3, VOL_V4 float4;
+ *   - C++ (src/volume/): every function a template on VOL_REAL (float for the scalar baseline,
+ *     double for the reference), VOL_V3 glm::vec<3, VOL_REAL>.
+ * Only operations both languages have appear: + - * / on reals and vectors, dot, length,
+ * normalize, sqrt, exp, expm1, pow, floor, fmin, fmax, fabs, and the hooks below.
+ * VOL_T(f) names a function whose real type cannot be deduced from its arguments. */
+#ifndef FOGCL_VOLUME_COMMON_H
+#define FOGCL_VOLUME_COMMON_H
+
+#ifdef __OPENCL_C_VERSION__
+#define VOL_FN static inline
+#define VOL_REAL float
+#define VOL_V3 float3
+#define VOL_V4 float4
+#define VOL_MAKE3(x, y, z) ((float3)((x), (y), (z)))
+#define VOL_MAKE4(x, y, z, w) ((float4)((x), (y), (z), (w)))
+#define VOL_GLOBAL global
+#define VOL_T(f) f
+#define VOL_UINT uint
+#define VOL_BYTE uchar
+#else
+#define VOL_FN template <typename VOL_REAL> inline
+#define VOL_V3 glm::vec<3, VOL_REAL>
+#define VOL_V4 glm::vec<4, VOL_REAL>
+#define VOL_MAKE3(x, y, z) VOL_V3((x), (y), (z))
+#define VOL_MAKE4(x, y, z, w) VOL_V4((x), (y), (z), (w))
+#define VOL_GLOBAL
+#define VOL_T(f) f<VOL_REAL>
+#define VOL_UINT std::uint32_t
+#define VOL_BYTE std::uint8_t
+#endif
+
+/* A packed parameter, read in the path's precision. */
+#define VOL_P(array, index) ((VOL_REAL)(array)[index])
+#define VOL_P3(array, index) VOL_MAKE3(VOL_P(array, index), VOL_P(array, (index) + 1), VOL_P(array, (index) + 2))
+#define VOL_P4(array, index) \
+  VOL_MAKE4(VOL_P(array, index), VOL_P(array, (index) + 1), VOL_P(array, (index) + 2), VOL_P(array, (index) + 3))
+
+/* Integrators (VOL_INTEGRATOR, VolumeIntegrator). */
+#define VOL_STYLIZED 1
+#define VOL_PHYSICAL 2
+
+/* The per-frame array (src/volume/volume_params.cpp packs it): camera, light, shadow map. */
+#define VOL_F_EYE 0          /* world position of the camera (3) */
+#define VOL_F_RIGHT 3        /* view -> world rotation columns (3 each) */
+#define VOL_F_UP 6
+#define VOL_F_FORWARD 9
+#define VOL_F_CORNERS 12     /* view-space far corner rays, Corner order bl br tl tr (4 x 3) */
+#define VOL_F_NEAR 24
+#define VOL_F_FAR 25
+#define VOL_F_ZX 26          /* _ZBufferParams.x, .y */
+#define VOL_F_ZY 27
+#define VOL_F_CORNER_Z 28    /* view z of the corner rays: far, or 1 with an infinite far plane */
+#define VOL_F_LIGHT_DIR 29   /* unit, toward the light (3) */
+#define VOL_F_LIGHT_COLOR 32 /* (3) */
+#define VOL_F_TIME 35
+#define VOL_F_WIDTH 36       /* the full-resolution frame */
+#define VOL_F_HEIGHT 37
+#define VOL_F_SCALE 38       /* resolution divisor s: 1, 2 or 4 */
+#define VOL_F_LOW_WIDTH 39   /* ceil(W / s), ceil(H / s) */
+#define VOL_F_LOW_HEIGHT 40
+#define VOL_F_SHADOW_MATRIX 41 /* world -> light clip, column-major (16) */
+#define VOL_F_SHADOW_WIDTH 57
+#define VOL_F_SHADOW_HEIGHT 58
+#define VOL_F_SHADOW_BIAS 59
+#define VOL_F_COUNT 64
+
+/* One volume's parameters (docs/volumetric.md §Volume), resolved defaults included. */
+#define VOL_V_CENTER 0       /* (3) */
+#define VOL_V_RADIUS 3
+#define VOL_V_DENSITY 4
+#define VOL_V_MAX_Y 5
+#define VOL_V_FADE_Y 6
+#define VOL_V_FADE_EDGE 7
+#define VOL_V_PROXIMITY_FADE 8
+#define VOL_V_FOG_EXPONENT 9
+#define VOL_V_FOG_CUTOFF 10
+#define VOL_V_DETAIL_EXPONENT 11
+#define VOL_V_DETAIL_STRENGTH 12
+#define VOL_V_FOG_COLOR 13   /* (4) */
+#define VOL_V_DIR_FOG_COLOR 17 /* (4) */
+#define VOL_V_DIR_FALLOFF 21
+#define VOL_V_LIGHT_CONTRIBUTION 22
+#define VOL_V_DIR_LIGHT_CONTRIBUTION 23
+#define VOL_V_SHADOW_STRENGTH 24
+#define VOL_V_SHADOW_REVERSE_STRENGTH 25
+#define VOL_V_TILING 26      /* (3) */
+#define VOL_V_SPEED 29       /* (3) */
+#define VOL_V_DETAIL_TILING 32 /* (3) */
+#define VOL_V_DETAIL_SPEED_MODIFIER 35
+#define VOL_V_OVERSHOOT 36
+#define VOL_V_NOISE 37       /* 1: noise shapes the density, 0: density field 1 */
+#define VOL_V_ALBEDO 38      /* (3) */
+#define VOL_V_ANISOTROPY 41
+#define VOL_V_AMBIENT 42     /* (3) */
+#define VOL_V_STRIDE 48
+
+/* The seed's constants, named where the march uses them. */
+#define VOL_JITTER_SPAN 0.1f       /* stylized start offset: -jitter * step * 0.1 */
+#define VOL_ADAPTIVE_ONSET 0.1f    /* stylized: refine once the noise exceeds this */
+#define VOL_ADAPTIVE_FACTOR 0.2f   /* ... to steps of 0.2 * step */
+#define VOL_ADAPTIVE_BACK 4.0f     /* ... after going back 4 small steps */
+#define VOL_LIGHT_FLOOR 0.1f       /* stylized: color never below 0.1 * light color */
+
+#endif

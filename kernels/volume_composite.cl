@@ -1,0 +1,71 @@
+/* volume_composite.cl — the target upsampled onto the frame and composited over it
+ * (docs/volumetric.md §Resolution and composite). One work-item per frame pixel.
+ *
+ * Variant switches (the host's volume_composite_options()):
+ *   VOL_SCALE        resolution divisor s: 1, 2 or 4
+ *   VOL_DEPTH_AWARE  1: bilinear x depth similarity; 0: bilinear (the seed's blit)
+ *   FOG_PROJECTION, REVERSED_Z  as in volume_march.cl (the pixel's depth for the similarity)
+ *   FOG_COLOR_HALF   RGBA half storage; else RGBA float
+ */
+#pragma OPENCL FP_CONTRACT OFF
+
+#define FOG_REAL float
+#define FOG_INT int
+#define FOG_AS_UINT as_uint
+#define FOG_TRUNC_INT convert_int
+#define FOG_TO_REAL convert_float
+#define FOG_AS_REAL as_float
+#define FOG_NAME(name) name
+#define FOG_EXP2 fog_exp2_poly
+#include "fog_math.h"
+
+#ifdef REVERSED_Z
+#define VOL_REVERSED_Z 1
+#else
+#define VOL_REVERSED_Z 0
+#endif
+
+#include "volume_common.h"
+#include "volume_ray.h"
+#include "volume_composite.h"
+
+#ifdef FOG_COLOR_HALF
+#define COLOR_T half
+#else
+#define COLOR_T float
+#endif
+
+kernel void volume_composite(global const COLOR_T* color_in, global const float* depth, global COLOR_T* color_out,
+                             global const float* frame, global const float* low, global const float* low_key) {
+  const int x = get_global_id(0), y = get_global_id(1);
+  const int width = (int)frame[VOL_F_WIDTH];
+  if (x >= width || y >= (int)frame[VOL_F_HEIGHT]) return;
+  const size_t i = (size_t)y * (size_t)width + (size_t)x;
+  float key = 0.0f;
+#if VOL_DEPTH_AWARE && VOL_SCALE > 1
+  key = vol_eye_depth(depth[i], FOG_PROJECTION, VOL_REVERSED_Z, frame[VOL_F_ZX], frame[VOL_F_ZY],
+                      frame[VOL_F_NEAR], frame[VOL_F_FAR]);
+#endif
+  const float4 fog = vol_upsample(x, y, key, low, low_key, (int)frame[VOL_F_LOW_WIDTH],
+                                  (int)frame[VOL_F_LOW_HEIGHT], VOL_SCALE, VOL_DEPTH_AWARE);
+#ifdef FOG_COLOR_HALF
+  if (fog.w == 0.0f) { /* no fog: the bits pass through (a half trip would quiet a signalling NaN) */
+    vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
+    return;
+  }
+  const float4 c = vload_half4(i, color_in);
+#else
+  if (fog.w == 0.0f) {
+    vstore4(vload4(i, (global const uint*)color_in), i, (global uint*)color_out);
+    return;
+  }
+  const float4 c = vload4(i, color_in);
+#endif
+  const float4 o = (float4)(vol_composite(c.x, fog.x, fog.w), vol_composite(c.y, fog.y, fog.w),
+                            vol_composite(c.z, fog.z, fog.w), c.w);
+#ifdef FOG_COLOR_HALF
+  vstore_half4_rte(o, i, color_out);
+#else
+  vstore4(o, i, color_out);
+#endif
+}

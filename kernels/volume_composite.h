@@ -1,0 +1,50 @@
+/* volume_composite.h — the target back to full resolution and over the frame
+ * (docs/volumetric.md §Resolution and composite). Needs volume_common.h. */
+
+/* Weight floor of the depth-aware upsampling: a tap's weight is its bilinear weight over
+ * (VOL_UPSAMPLE_EPS + relative depth difference), so taps on the pixel's own surface win about
+ * 50 : 1 over taps across a silhouette, and taps on one surface keep plain bilinear weights. */
+#define VOL_UPSAMPLE_EPS 0.01f
+
+/* |a - b| / max(a, b) for eye depths >= 0 (+inf for sky): 0 for equal depths, sky included, 1
+ * between sky and a surface. */
+VOL_FN VOL_REAL vol_depth_difference(VOL_REAL a, VOL_REAL b) {
+  const VOL_REAL hi = fmax(a, b), lo = fmin(a, b);
+  if (hi == lo) return (VOL_REAL)0;
+  if (!(hi < (VOL_REAL)INFINITY)) return (VOL_REAL)1;
+  return (hi - lo) / hi;
+}
+
+/* The target (P, A) at full-resolution pixel (x, y) of eye depth `key`: the 2 x 2 nearest target
+ * pixels (their centres are block centres; edges clamp), bilinear, or bilinear x depth similarity
+ * when depth_aware. Scale 1 returns the pixel's own sample unchanged. */
+VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL key, VOL_GLOBAL const VOL_REAL* low, VOL_GLOBAL const VOL_REAL* low_key,
+                           int low_width, int low_height, int scale, int depth_aware) {
+  const VOL_REAL s = (VOL_REAL)scale;
+  const VOL_REAL gx = ((VOL_REAL)x + (VOL_REAL)0.5f) / s - (VOL_REAL)0.5f;
+  const VOL_REAL gy = ((VOL_REAL)y + (VOL_REAL)0.5f) / s - (VOL_REAL)0.5f;
+  const VOL_REAL fx0 = floor(gx), fy0 = floor(gy);
+  const VOL_REAL fx = gx - fx0, fy = gy - fy0;
+  const int x0 = max((int)fx0, 0), y0 = max((int)fy0, 0);
+  const int x1 = min((int)fx0 + 1, low_width - 1), y1 = min((int)fy0 + 1, low_height - 1);
+  const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
+  const VOL_REAL bilinear[4] = {((VOL_REAL)1 - fx) * ((VOL_REAL)1 - fy), fx * ((VOL_REAL)1 - fy),
+                                ((VOL_REAL)1 - fx) * fy, fx * fy};
+  VOL_V4 sum = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  VOL_REAL weight = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (bilinear[k] == (VOL_REAL)0) continue;
+    const size_t i = (size_t)ys[k] * (size_t)low_width + (size_t)xs[k];
+    VOL_REAL w = bilinear[k];
+    if (depth_aware) w = w / ((VOL_REAL)VOL_UPSAMPLE_EPS + vol_depth_difference(key, (VOL_REAL)low_key[i]));
+    sum = sum + VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3)) * w;
+    weight += w;
+  }
+  return sum / weight;
+}
+
+/* One channel over the fog (DESIGN §5.4): P + c (1 - A). A == 1 writes P exactly (a hidden
+ * NaN/Inf never leaks); the caller passes A == 0 pixels through bit for bit. */
+VOL_FN VOL_REAL vol_composite(VOL_REAL c, VOL_REAL premultiplied, VOL_REAL coverage) {
+  return coverage == (VOL_REAL)1 ? premultiplied : premultiplied + c * ((VOL_REAL)1 - coverage);
+}

@@ -1,0 +1,242 @@
+/* volume_integrate.h — the two integrators of the march (docs/volumetric.md §March) and the
+ * per-pixel entry both the kernel and the C++ paths run. Needs volume_common.h, volume_ray.h and
+ * volume_noise.h.
+ *
+ * features: a bit set of VOL_FEATURE_* (compile-time constants in the kernel, so a variant holds
+ * no code for what the scene does not use). */
+#define VOL_FEATURE_NOISE 1          /* some volume has noise: sample the shape noise */
+#define VOL_FEATURE_DETAIL 2         /* ... and detail noise (detail_strength > 0 somewhere) */
+#define VOL_FEATURE_FADES 4          /* some fade can be below 1 */
+#define VOL_FEATURE_SHADOW 8         /* a shadow map is bound */
+#define VOL_FEATURE_SHADOW_REVERSED 16 /* ... holding reversed Z */
+#define VOL_FEATURE_ADAPTIVE 32      /* stylized: the seed's adaptive stepping */
+#define VOL_MAX_VOLUMES 32           /* visible volumes per frame (the host checks) */
+
+/* Henyey-Greenstein phase function, normalised over the sphere (1 / 4 pi when g = 0); cos_theta
+ * between the ray and the direction toward the light (forward scattering peaks looking at it). */
+VOL_FN VOL_REAL vol_phase_hg(VOL_REAL cos_theta, VOL_REAL g) {
+  const VOL_REAL denom = (VOL_REAL)1 + g * g - (VOL_REAL)2 * g * cos_theta;
+  return ((VOL_REAL)1 - g * g) / ((VOL_REAL)(4.0 * 3.14159265358979323846) * denom * sqrt(denom));
+}
+
+/* 1 where world point p is lit, 0 in shadow: p is projected by the world -> light clip matrix
+ * (column-major) and compared with the map's nearest texel, with the bias toward lit. Points
+ * outside the map, behind the light, or over a NaN texel are lit. */
+VOL_FN VOL_REAL vol_shadow_lit(VOL_V3 p, VOL_GLOBAL const float* frame, VOL_GLOBAL const float* shadow_map,
+                               int reversed_z) {
+  VOL_REAL clip[4];
+  for (int r = 0; r < 4; ++r)
+    clip[r] = VOL_P(frame, VOL_F_SHADOW_MATRIX + r) * p.x + VOL_P(frame, VOL_F_SHADOW_MATRIX + 4 + r) * p.y +
+              VOL_P(frame, VOL_F_SHADOW_MATRIX + 8 + r) * p.z + VOL_P(frame, VOL_F_SHADOW_MATRIX + 12 + r);
+  if (!(clip[3] > (VOL_REAL)0)) return (VOL_REAL)1;
+  const VOL_REAL u = clip[0] / clip[3] * (VOL_REAL)0.5f + (VOL_REAL)0.5f;
+  const VOL_REAL v = clip[1] / clip[3] * (VOL_REAL)0.5f + (VOL_REAL)0.5f;
+  if (!(u >= (VOL_REAL)0 && u < (VOL_REAL)1 && v >= (VOL_REAL)0 && v < (VOL_REAL)1)) return (VOL_REAL)1;
+  const int w = (int)VOL_P(frame, VOL_F_SHADOW_WIDTH), h = (int)VOL_P(frame, VOL_F_SHADOW_HEIGHT);
+  const int x = min((int)(u * (VOL_REAL)w), w - 1), y = min((int)(((VOL_REAL)1 - v) * (VOL_REAL)h), h - 1);
+  const VOL_REAL map = (VOL_REAL)shadow_map[(size_t)y * (size_t)w + (size_t)x];
+  const VOL_REAL z = clip[2] / clip[3], bias = VOL_P(frame, VOL_F_SHADOW_BIAS);
+  const int shadowed = reversed_z ? z < map - bias : z > map + bias;
+  return shadowed ? (VOL_REAL)0 : (VOL_REAL)1;
+}
+
+/* stylized: one volume as the seed's shader draws it, (rgb, alpha) before blending. [front,
+ * back] is the ray's part inside the sphere, t_scene the occluder. The march covers
+ * min((t_scene - front) * occluder_overshoot, thickness) in `steps` steps from a start offset of
+ * -jitter * step * 0.1; the first sample whose noise exceeds 0.1 switches to steps of 0.2 * step
+ * after going back 4 of them, and is itself skipped (the seed's adaptive stepping, never back to
+ * full steps). Alpha is fog_color.a * saturate(saturate(accumulation / distance) * density). */
+VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_REAL back,
+                                  VOL_REAL t_scene, VOL_REAL jitter, VOL_GLOBAL const float* vol,
+                                  VOL_GLOBAL const float* frame, VOL_NOISE_PARAM, int noise_size,
+                                  VOL_GLOBAL const float* shadow_map, int steps, int features) {
+  const VOL_REAL thickness = back - front;
+  const VOL_REAL reach = t_scene < (VOL_REAL)INFINITY
+                             ? fmin((t_scene - front) * VOL_P(vol, VOL_V_OVERSHOOT), thickness)
+                             : thickness;
+  if (!(reach > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  const VOL_REAL step = reach / (VOL_REAL)steps, time = VOL_P(frame, VOL_F_TIME);
+  const int noisy = (features & VOL_FEATURE_NOISE) && VOL_P(vol, VOL_V_NOISE) != (VOL_REAL)0;
+  VOL_REAL marched = -jitter * step * (VOL_REAL)VOL_JITTER_SPAN, current = step;
+  VOL_REAL accumulation = 0, shadowed = 0;
+  int refined = !(features & VOL_FEATURE_ADAPTIVE);
+  for (int i = 0; i < steps; ++i) {
+    marched += current;
+    const VOL_REAL t = front + marched;
+    const VOL_V3 p = origin + dir * t;
+    VOL_REAL fog = noisy ? vol_density_field(vol, p, time, noise, noise_size, features & VOL_FEATURE_DETAIL)
+                         : (VOL_REAL)1;
+    if (!refined && fog > (VOL_REAL)VOL_ADAPTIVE_ONSET) {
+      current = step * (VOL_REAL)VOL_ADAPTIVE_FACTOR;
+      marched -= current * (VOL_REAL)VOL_ADAPTIVE_BACK;
+      refined = 1;
+      continue;
+    }
+    if (features & VOL_FEATURE_FADES) fog *= vol_fades(vol, p, t);
+    if (features & VOL_FEATURE_SHADOW)
+      shadowed += ((VOL_REAL)1 - vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)) * current;
+    accumulation += fog * current;
+  }
+  if (!(marched > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  /* The lobe toward the light bends colour and light (the seed's k). */
+  const VOL_V3 light_dir = VOL_P3(frame, VOL_F_LIGHT_DIR), light = VOL_P3(frame, VOL_F_LIGHT_COLOR);
+  const VOL_REAL k = vol_pow(vol_saturate(dot(dir, light_dir)), VOL_P(vol, VOL_V_DIR_FALLOFF));
+  const VOL_V3 one = VOL_MAKE3((VOL_REAL)1, (VOL_REAL)1, (VOL_REAL)1);
+  const VOL_V3 base_light = one + (light - one) * VOL_P(vol, VOL_V_LIGHT_CONTRIBUTION);
+  const VOL_V3 lobe_light = one + (light - one) * VOL_P(vol, VOL_V_DIR_LIGHT_CONTRIBUTION);
+  const VOL_V3 light_color = base_light + (lobe_light - base_light) * k;
+  const VOL_V4 fog_color = VOL_P4(vol, VOL_V_FOG_COLOR) + (VOL_P4(vol, VOL_V_DIR_FOG_COLOR) - VOL_P4(vol, VOL_V_FOG_COLOR)) * k;
+  VOL_REAL total_shadow = (VOL_REAL)1;
+  if (features & VOL_FEATURE_SHADOW) {
+    const VOL_REAL strength = VOL_P(vol, VOL_V_SHADOW_STRENGTH);
+    const VOL_REAL reverse = strength * VOL_P(vol, VOL_V_SHADOW_REVERSE_STRENGTH);
+    total_shadow = (VOL_REAL)1 - vol_saturate(shadowed / marched) * (reverse + (strength - reverse) * k);
+  }
+  const VOL_V3 lit = light_color * total_shadow, floor_light = light_color * (VOL_REAL)VOL_LIGHT_FLOOR;
+  const VOL_V3 rgb = VOL_MAKE3(fog_color.x, fog_color.y, fog_color.z) *
+                     VOL_MAKE3(fmax(lit.x, floor_light.x), fmax(lit.y, floor_light.y), fmax(lit.z, floor_light.z));
+  const VOL_REAL alpha = fog_color.w * vol_saturate(vol_saturate(accumulation / marched) * VOL_P(vol, VOL_V_DENSITY));
+  return VOL_MAKE4(rgb.x, rgb.y, rgb.z, alpha);
+}
+
+/* The extinction [1/world] and the albedo-weighted light of the volumes of `mask` at p, t:
+ * sigma_t = density * field * fades per volume, summed; *source = sum of sigma_t * albedo * L with
+ * L = light * phase * shadow + ambient. */
+VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, VOL_REAL cos_theta, VOL_REAL lit, VOL_UINT mask,
+                                    VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
+                                    VOL_NOISE_PARAM, int noise_size, int features, VOL_V3* source) {
+  const VOL_V3 light = VOL_P3(frame, VOL_F_LIGHT_COLOR);
+  const VOL_REAL time = VOL_P(frame, VOL_F_TIME);
+  VOL_REAL sigma_t = 0;
+  VOL_V3 s = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  for (int i = 0; i < count; ++i) {
+    if (!((mask >> i) & 1u)) continue;
+    VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
+    VOL_REAL sigma = VOL_P(vol, VOL_V_DENSITY);
+    if ((features & VOL_FEATURE_NOISE) && VOL_P(vol, VOL_V_NOISE) != (VOL_REAL)0)
+      sigma *= vol_density_field(vol, p, time, noise, noise_size, features & VOL_FEATURE_DETAIL);
+    if (features & VOL_FEATURE_FADES) sigma *= vol_fades(vol, p, t);
+    const VOL_V3 in_light = light * (vol_phase_hg(cos_theta, VOL_P(vol, VOL_V_ANISOTROPY)) * lit) +
+                            VOL_P3(vol, VOL_V_AMBIENT);
+    s = s + VOL_P3(vol, VOL_V_ALBEDO) * in_light * sigma;
+    sigma_t += sigma;
+  }
+  *source = s;
+  return sigma_t;
+}
+
+/* physical (Hillaire 2015, "Physically Based and Unified Volumetric Rendering in Frostbite"):
+ * all volumes of the ray at once, returns (in-scattered I, premultiplied; coverage 1 - T).
+ * The ray's covered stretch is cut at every sphere boundary into pieces where the same volumes
+ * overlap; the steps are shared out in proportion to length (at least one per piece), so the
+ * segments tile each sphere's chord [front, min(back, t_scene)] exactly. Per segment of length
+ * d with extinction sigma_t sampled inside it (jitter: where; unjittered: the midpoint):
+ * I += T * (source / sigma_t) * (1 - e^(-sigma_t d)), optical depth += sigma_t d. Exact for
+ * piecewise-constant media at any d: with albedo 1 and unit light, I + T = 1 to rounding. The
+ * (1 - e^x) is -expm1, so thin media keep their digits, and nothing divides by sigma_t but the
+ * sigma_t-weighted mean source / sigma_t of the volumes' albedo * L, taken only where sigma_t > 0
+ * (the textbook (S - S e^(-sigma_t d)) / sigma_t form is 0 / 0 in clear air). */
+VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL jitter,
+                           VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
+                           VOL_NOISE_PARAM, int noise_size, VOL_GLOBAL const float* shadow_map,
+                           int steps, int features) {
+  VOL_REAL t_in[VOL_MAX_VOLUMES], t_out[VOL_MAX_VOLUMES];
+  VOL_REAL start = (VOL_REAL)INFINITY;
+  VOL_UINT hit = 0u;
+  for (int i = 0; i < count; ++i) {
+    VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
+    VOL_REAL t0, t1;
+    if (!vol_sphere_hit(origin, dir, VOL_P3(vol, VOL_V_CENTER), VOL_P(vol, VOL_V_RADIUS), &t0, &t1)) continue;
+    t1 = fmin(t1, t_scene);
+    if (!(t1 > t0)) continue;
+    t_in[i] = t0;
+    t_out[i] = t1;
+    hit |= 1u << i;
+    start = fmin(start, t0);
+  }
+  VOL_REAL i_r = 0, i_g = 0, i_b = 0, depth = 0;
+  if (hit == 0u) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  const VOL_REAL cos_theta = dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR));
+  VOL_REAL covered = 0;
+  /* Pass 0 measures the covered length, pass 1 integrates. */
+  for (int pass = 0; pass < 2; ++pass) {
+    VOL_REAL a = start;
+    for (int piece = 0; piece < 2 * count; ++piece) {
+      VOL_REAL b = (VOL_REAL)INFINITY;
+      for (int i = 0; i < count; ++i) {
+        if (!((hit >> i) & 1u)) continue;
+        if (t_in[i] > a) b = fmin(b, t_in[i]);
+        if (t_out[i] > a) b = fmin(b, t_out[i]);
+      }
+      if (!(b < (VOL_REAL)INFINITY)) break;
+      VOL_UINT mask = 0u;
+      for (int i = 0; i < count; ++i)
+        if (((hit >> i) & 1u) && t_in[i] <= a && t_out[i] >= b) mask |= 1u << i;
+      const VOL_REAL length_ab = b - a;
+      if (mask != 0u && pass == 0) covered += length_ab;
+      if (mask != 0u && pass == 1) {
+        const int n = max(1, (int)floor(length_ab * (VOL_REAL)steps / covered + (VOL_REAL)0.5f));
+        for (int j = 0; j < n; ++j) {
+          const VOL_REAL s0 = a + length_ab * (VOL_REAL)j / (VOL_REAL)n;
+          const VOL_REAL s1 = j + 1 == n ? b : a + length_ab * (VOL_REAL)(j + 1) / (VOL_REAL)n;
+          const VOL_REAL seg = s1 - s0, t = s0 + jitter * seg;
+          const VOL_V3 p = origin + dir * t;
+          const VOL_REAL lit = (features & VOL_FEATURE_SHADOW)
+                                   ? vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)
+                                   : (VOL_REAL)1;
+          VOL_V3 source;
+          const VOL_REAL sigma_t = vol_physical_sample(p, t, cos_theta, lit, mask, vols, count, frame, noise,
+                                                       noise_size, features, &source);
+          if (!(sigma_t > (VOL_REAL)0)) continue;
+          const VOL_REAL scatter = -expm1(-sigma_t * seg) * exp(-depth) / sigma_t;
+          i_r += source.x * scatter;
+          i_g += source.y * scatter;
+          i_b += source.z * scatter;
+          depth += sigma_t * seg;
+        }
+      }
+      a = b;
+    }
+  }
+  return VOL_MAKE4(i_r, i_g, i_b, -expm1(-depth));
+}
+
+/* The target pixel (lx, ly): its ray, its occluder, the march of the chosen integrator. Returns
+ * (P premultiplied RGB, coverage A) and the block's eye depth in *key for the upsampling. */
+VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
+                              VOL_GLOBAL const float* vols, int count, VOL_NOISE_PARAM, int noise_size,
+                              VOL_GLOBAL const float* shadow_map, VOL_UINT frame_index, int integrator, int steps,
+                              int features, int jitter, int projection, int reversed_z, VOL_REAL* key) {
+  const int scale = (int)VOL_P(frame, VOL_F_SCALE);
+  const VOL_REAL near_plane = VOL_P(frame, VOL_F_NEAR);
+  const VOL_REAL eye_depth = vol_block_eye_depth(depth_buffer, lx, ly, scale, (int)VOL_P(frame, VOL_F_WIDTH),
+                                                 (int)VOL_P(frame, VOL_F_HEIGHT), projection, reversed_z,
+                                                 VOL_P(frame, VOL_F_ZX), VOL_P(frame, VOL_F_ZY), near_plane,
+                                                 VOL_P(frame, VOL_F_FAR));
+  *key = eye_depth;
+  VOL_V3 origin, dir;
+  VOL_REAL t_per_eye;
+  const VOL_REAL block_centre = (VOL_REAL)scale * (VOL_REAL)0.5f;
+  vol_pixel_ray((VOL_REAL)(lx * scale) + block_centre, (VOL_REAL)(ly * scale) + block_centre, frame, projection, &origin, &dir,
+                &t_per_eye);
+  const VOL_REAL t_scene = vol_scene_distance(eye_depth, near_plane, t_per_eye);
+  const float j = vol_jitter((VOL_UINT)lx, (VOL_UINT)ly, frame_index);
+  if (integrator == VOL_PHYSICAL)
+    return vol_physical(origin, dir, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame, noise,
+                        noise_size, shadow_map, steps, features);
+  /* stylized: each volume drawn over the target in the order given, with the seed's blend
+   * (SrcAlpha, OneMinusSrcAlpha; One, OneMinusSrcAlpha): premultiplied colour and coverage. */
+  VOL_V4 target = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  for (int i = 0; i < count; ++i) {
+    VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
+    VOL_REAL t0, t1;
+    if (!vol_sphere_hit(origin, dir, VOL_P3(vol, VOL_V_CENTER), VOL_P(vol, VOL_V_RADIUS), &t0, &t1)) continue;
+    if (!(t0 < t_scene)) continue;
+    const VOL_V4 c = vol_stylized_volume(origin, dir, t0, t1, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0, vol, frame,
+                                         noise, noise_size, shadow_map, steps, features);
+    const VOL_REAL keep = (VOL_REAL)1 - c.w;
+    target = VOL_MAKE4(c.x * c.w + target.x * keep, c.y * c.w + target.y * keep, c.z * c.w + target.z * keep,
+                       c.w + target.w * keep);
+  }
+  return target;
+}

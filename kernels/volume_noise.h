@@ -1,0 +1,114 @@
+/* volume_noise.h — what shapes a volume's density (docs/volumetric.md §Volume): the per-ray
+ * jitter hash, the noise texture's trilinear sample, the seed's shape + detail density field and
+ * its fades. Needs volume_common.h. */
+
+/* PCG hash (Jarzynski & Olano, "Hash Functions for GPU Rendering", JCGT 2020): one 32-bit
+ * state step and output permutation; integer arithmetic, the same bits in every path. */
+#ifdef __OPENCL_C_VERSION__
+static inline uint vol_hash(uint v) {
+#else
+inline std::uint32_t vol_hash(std::uint32_t v) {
+#endif
+  const VOL_UINT state = v * 747796405u + 2891336453u;
+  const VOL_UINT word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+/* Per-ray jitter in [0, 1) from (target pixel, frame index): a new value every frame, so the
+ * mean over frames converges to the unjittered high-step march. 24 bits: exact in float. */
+#ifdef __OPENCL_C_VERSION__
+static inline float vol_jitter(uint x, uint y, uint frame_index) {
+#else
+inline float vol_jitter(std::uint32_t x, std::uint32_t y, std::uint32_t frame_index) {
+#endif
+  const VOL_UINT h = vol_hash(x + vol_hash(y + vol_hash(frame_index)));
+  return (float)(h >> 8) * 0x1p-24f;
+}
+
+/* The texture's texel (x, y, z) as four bytes 0..255 (docs/volumetric-noise.md: unorm8 RGBA,
+ * x fastest). */
+#ifdef __OPENCL_C_VERSION__
+#define VOL_TEXEL(tex, n, x, y, z) convert_float4(vload4(((size_t)(z) * (n) + (y)) * (n) + (x), (tex)))
+#else
+#define VOL_TEXEL(tex, n, x, y, z) vol_texel<VOL_REAL>((tex), (n), (x), (y), (z))
+template <typename VOL_REAL>
+inline VOL_V4 vol_texel(const std::uint8_t* tex, int n, int x, int y, int z) {
+  const std::uint8_t* t = tex + ((std::size_t(z) * n + y) * n + x) * 4;
+  return VOL_V4(t[0], t[1], t[2], t[3]);
+}
+#endif
+
+/* Trilinear sample with wrap-around at uvw (texel centres at (i + 0.5) / N), in [0, 1]: the
+ * manual filter of the buffer variant, in the path's precision. uvw is first wrapped to [0, 1),
+ * so far-away or late-in-time coordinates cost no integer overflow. */
+VOL_FN VOL_V4 vol_noise_trilinear(VOL_GLOBAL const VOL_BYTE* tex, int n, VOL_V3 uvw) {
+  const VOL_REAL fn = (VOL_REAL)n;
+  const VOL_V3 g = (uvw - floor(uvw)) * fn - (VOL_REAL)0.5f;
+  const VOL_V3 g0 = floor(g);
+  const VOL_V3 f = g - g0;
+  const int mask = n - 1; /* n is a power of two */
+  const int x0 = ((int)g0.x + n) & mask, y0 = ((int)g0.y + n) & mask, z0 = ((int)g0.z + n) & mask;
+  const int x1 = (x0 + 1) & mask, y1 = (y0 + 1) & mask, z1 = (z0 + 1) & mask;
+  const VOL_V4 c00 = VOL_TEXEL(tex, n, x0, y0, z0) + (VOL_TEXEL(tex, n, x1, y0, z0) - VOL_TEXEL(tex, n, x0, y0, z0)) * f.x;
+  const VOL_V4 c10 = VOL_TEXEL(tex, n, x0, y1, z0) + (VOL_TEXEL(tex, n, x1, y1, z0) - VOL_TEXEL(tex, n, x0, y1, z0)) * f.x;
+  const VOL_V4 c01 = VOL_TEXEL(tex, n, x0, y0, z1) + (VOL_TEXEL(tex, n, x1, y0, z1) - VOL_TEXEL(tex, n, x0, y0, z1)) * f.x;
+  const VOL_V4 c11 = VOL_TEXEL(tex, n, x0, y1, z1) + (VOL_TEXEL(tex, n, x1, y1, z1) - VOL_TEXEL(tex, n, x0, y1, z1)) * f.x;
+  const VOL_V4 c0 = c00 + (c10 - c00) * f.y, c1 = c01 + (c11 - c01) * f.y;
+  return (c0 + (c1 - c0) * f.z) / (VOL_REAL)255;
+}
+
+/* The includer may replace the sample (the image variant: the sampler's linear filter). */
+#ifndef VOL_NOISE_SAMPLE
+#define VOL_NOISE_SAMPLE(tex, n, uvw) vol_noise_trilinear((tex), (n), (uvw))
+#endif
+#ifndef VOL_NOISE_PARAM
+#define VOL_NOISE_PARAM VOL_GLOBAL const VOL_BYTE* noise
+#endif
+
+VOL_FN VOL_REAL vol_saturate(VOL_REAL x) { return fmin(fmax(x, (VOL_REAL)0), (VOL_REAL)1); }
+
+/* x^e with the seed's default e = 1 exact (pow may round even then). */
+VOL_FN VOL_REAL vol_pow(VOL_REAL x, VOL_REAL e) { return e == (VOL_REAL)1 ? x : pow(x, e); }
+
+/* The seed's density field in [0, 1] at world point p: shape noise (R) to fog_exponent, the
+ * cut-off, then eroded by detail noise (R, B, A weighted 0.6 / 0.25 / 0.15; G is unused, as in
+ * the seed). The cut-off remaps [cutoff, 1] to [0, 1]: the seed divides by (1 - fog) instead,
+ * which saturates all noise above (1 + cutoff) / 2 and is singular at fog = 1 (a departure,
+ * docs/volumetric.md §Departures). */
+VOL_FN VOL_REAL vol_density_field(VOL_GLOBAL const float* vol, VOL_V3 p, VOL_REAL time, VOL_NOISE_PARAM,
+                                  int noise_size, int detail) {
+  const VOL_V3 speed = VOL_P3(vol, VOL_V_SPEED);
+  const VOL_V3 uvw = (p + speed * time) * VOL_P3(vol, VOL_V_TILING);
+  const VOL_REAL cutoff = VOL_P(vol, VOL_V_FOG_CUTOFF);
+  VOL_REAL fog = vol_pow(VOL_NOISE_SAMPLE(noise, noise_size, uvw).x, VOL_P(vol, VOL_V_FOG_EXPONENT));
+  fog = vol_saturate((fog - cutoff) / ((VOL_REAL)1 - cutoff));
+  if (detail) {
+    const VOL_REAL strength = VOL_P(vol, VOL_V_DETAIL_STRENGTH), e = VOL_P(vol, VOL_V_DETAIL_EXPONENT);
+    const VOL_V3 duvw = (p + speed * (VOL_P(vol, VOL_V_DETAIL_SPEED_MODIFIER) * time)) * VOL_P3(vol, VOL_V_DETAIL_TILING);
+    const VOL_V4 d = VOL_NOISE_SAMPLE(noise, noise_size, duvw);
+    const VOL_REAL erosion = (VOL_REAL)0.6f * vol_pow(d.x, e) + (VOL_REAL)0.25f * vol_pow(d.z, e) +
+                             (VOL_REAL)0.15f * vol_pow(d.w, e);
+    fog = fog * ((VOL_REAL)1 - strength) + strength * erosion;
+  }
+  return fog;
+}
+
+/* 1 up to end - width, falling linearly to 0 at end. A width of 0 is a hard step at end, never a
+ * division by zero (the seed divides by the width). */
+VOL_FN VOL_REAL vol_fade_out(VOL_REAL x, VOL_REAL end, VOL_REAL width) {
+  if (width > (VOL_REAL)0) return (VOL_REAL)1 - vol_saturate((x - (end - width)) / width);
+  return x < end ? (VOL_REAL)1 : (VOL_REAL)0;
+}
+
+/* The seed's three fades at world point p, t along the ray from its origin: the edge fade inward
+ * from the sphere's surface, the height fade below max_y, and the proximity fade, which thins fog
+ * within proximity_fade of the camera (the seed measures t without its jitter and step rewind;
+ * fogcl uses the sample's own t). */
+VOL_FN VOL_REAL vol_fades(VOL_GLOBAL const float* vol, VOL_V3 p, VOL_REAL t) {
+  const VOL_REAL edge = vol_fade_out(length(p - VOL_P3(vol, VOL_V_CENTER)), VOL_P(vol, VOL_V_RADIUS),
+                                     VOL_P(vol, VOL_V_FADE_EDGE));
+  const VOL_REAL height = vol_fade_out(p.y, VOL_P(vol, VOL_V_MAX_Y), VOL_P(vol, VOL_V_FADE_Y));
+  const VOL_REAL proximity_width = VOL_P(vol, VOL_V_PROXIMITY_FADE);
+  const VOL_REAL proximity = proximity_width > (VOL_REAL)0 ? vol_saturate(t / proximity_width) : (VOL_REAL)1;
+  return edge * height * proximity;
+}

@@ -1,0 +1,47 @@
+// The scalar C++ path of the volumetric pass: one thread, the shared kernel headers
+// (kernels/volume_*.h) instantiated in T. float is the baseline and the fallback without OpenCL;
+// double is the reference every other path is measured against (docs/volumetric.md §Error).
+#pragma once
+
+#include <vector>
+
+#include "fogcl/camera.h"
+#include "fogcl/image.h"
+#include "fogcl/volumes.h"
+
+namespace fogcl {
+
+template <class T>
+struct VolumeResult {
+  int width = 0, height = 0;          // the frame
+  std::vector<T> rgba;                // 4 * width * height: the composited frame, in T
+  std::vector<T> coverage;            // width * height: the upsampled coverage A (0: untouched)
+  int low_width = 0, low_height = 0;  // the target: ceil(W / s) x ceil(H / s)
+  std::vector<T> low;                 // 4 per target pixel: premultiplied RGB, coverage A
+  std::vector<T> low_key;             // per target pixel: the eye depth it marched to (+inf sky)
+  std::size_t visible = 0;            // volumes left after culling
+};
+
+// The whole pass in T: culling (with the depth image's range), the march at the settings'
+// resolution, the upsampling and the composite. Nothing visible: rgba is the input.
+template <class T>
+VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& camera,
+                               const VolumeScene& scene, const VolumeSettings& settings,
+                               const ShadowMap* shadow = nullptr);
+
+// Fogs `in` into `out` in float, in in's storage format (out may be in), with the OpenCL pass's
+// rules: A == 0 pixels keep their bits, alpha passes through.
+void apply_volumes_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                          const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
+                          const ShadowMap* shadow = nullptr);
+
+// max over pixels and R, G, B of |image - reference.rgba| (NaN differences count as +inf).
+double max_abs_rgb_error(const ColorImage& image, const VolumeResult<double>& reference);
+
+extern template VolumeResult<float> volumes_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,
+                                                          const VolumeScene&, const VolumeSettings&, const ShadowMap*);
+extern template VolumeResult<double> volumes_scalar<double>(const ColorImage&, const DepthImage&, const CameraParams&,
+                                                            const VolumeScene&, const VolumeSettings&,
+                                                            const ShadowMap*);
+
+}  // namespace fogcl

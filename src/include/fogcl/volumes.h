@@ -1,0 +1,134 @@
+// Volumetric fog volumes (docs/volumetric.md): spheres of noisy fog placed in the world,
+// ray-marched per pixel into a reduced-resolution target, upsampled and composited onto the lit
+// color. When the deferred fog runs too, the volumes are composited first.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "fogcl/camera.h"
+#include "fogcl/image.h"
+
+namespace fogcl {
+
+// One fog volume: a sphere with the seed's parameters ("Rendering Volumetric Fog Using Custom URP
+// Render Pass", vertexfragment.com), same names in snake_case and the same defaults. Lengths are
+// world units; a fade width of 0 means no fade.
+struct FogVolume {
+  glm::vec3 center{0.0f};               // [world], finite
+  float radius = 1.0f;                  // [world], finite, > 0
+  // Stylized: the seed's density scale of the final alpha, >= 0. Physical: the extinction
+  // coefficient sigma_t [1/world unit] at full noise, >= 0.
+  float density = 0.1f;
+  float max_y = 100.0f;                 // height fade: fog thins out towards this world y
+  float fade_y = 2.0f;                  // height fade width [world], >= 0 (0: no height fade)
+  float fade_edge = 20.0f;              // edge fade width in from the sphere's surface [world], >= 0
+  float proximity_fade = 10.0f;         // fade width in front of an occluder [world], >= 0
+  float fog_exponent = 1.0f;            // shape noise exponent, > 0
+  float fog_cutoff = 0.0f;              // noise below this is no fog, in [0, 1)
+  float detail_exponent = 1.0f;         // detail noise exponent, > 0
+  float detail_strength = 0.75f;        // how much detail noise erodes the shape, in [0, 1]
+  glm::vec4 fog_color{1.0f};            // linear RGBA, each in [0, 65504]; alpha scales coverage
+  glm::vec4 directional_fog_color{1.0f};  // color looking toward the light (stylized)
+  float directional_falloff = 1.0f;     // exponent of the toward-the-light lobe, > 0
+  float light_contribution = 1.0f;      // stylized: light color weight, >= 0
+  float directional_light_contribution = 1.0f;  // stylized: weight inside the lobe, >= 0
+  float shadow_strength = 1.0f;         // stylized: darkening by shadowed samples, >= 0
+  float shadow_reverse_strength = 1.0f; // stylized: recovery by lit samples, >= 0
+  glm::vec3 tiling{0.015f};             // shape noise uvw per world unit, finite
+  glm::vec3 speed{1.75f, -0.5f, 0.1f};  // shape noise scroll [world units / s], finite
+  glm::vec3 detail_tiling{0.015f};      // detail noise uvw per world unit, finite
+  float detail_speed_modifier = 2.0f;   // detail scroll = speed * this, finite
+  float occluder_overshoot = 5.0f;      // stylized: march this many times past an occluder, >= 0
+  bool noise = true;                    // false: the density field is 1 inside the sphere
+  // Physical integrator only.
+  std::optional<glm::vec3> albedo;      // single-scattering albedo in [0, 1]; default fog_color.rgb
+  float anisotropy = 0.0f;              // Henyey-Greenstein g in (-1, 1)
+  std::optional<glm::vec3> ambient;     // ambient radiance RGB >= 0; default 0.1 * light color
+};
+
+// Where the camera is (docs/volumetric.md §World): Unity's world space, left-handed, +y up.
+struct CameraPose {
+  glm::vec3 eye{0.0f};                  // [world], finite
+  glm::vec3 forward{0.0f, 0.0f, 1.0f};  // view direction, non-zero (normalised by fogcl)
+  glm::vec3 up{0.0f, 1.0f, 0.0f};       // non-zero, not parallel to forward
+};
+
+// The main (directional) light.
+struct MainLight {
+  glm::vec3 direction{0.0f, 1.0f, 0.0f};  // from the scene toward the light, non-zero
+  glm::vec3 color{1.0f};                  // linear RGB >= 0 (physical: irradiance)
+};
+
+// The main light's shadow map as the integration API sees it: a float32 raw-depth image of the
+// light (row 0 = top) and the world -> light clip matrix. Clip xy in [-1, 1] map to the map's uv
+// (v = 0 at the bottom row); clip z / w is the stored depth, in [0, 1]. A sample point is lit
+// when it is nearer the light than the map's depth + bias.
+struct ShadowMapParams {
+  glm::mat4 world_to_light_clip{1.0f};  // column-major (GLM); finite, invertible
+  bool reversed_z = false;              // the map holds 1 at the light's near plane
+  float bias = 1e-3f;                   // in depth units, finite, >= 0
+};
+
+// A host-side shadow map (convenience API).
+struct ShadowMap {
+  DepthImage depth;                     // >= 1x1
+  ShadowMapParams params;
+};
+
+enum class VolumeIntegrator {
+  stylized,  // the seed's accumulator, for visual parity with it
+  physical,  // energy-conserving (Hillaire 2015), exact for piecewise-constant extinction
+};
+
+enum class VolumeUpsampling {
+  depth_aware,  // bilinear weights x depth similarity: no fog bleeding across silhouettes
+  bilinear,     // the seed's blit
+};
+
+enum class NoiseSampling {
+  buffer,  // a buffer of unorm8 texels, trilinear filtering in the kernel (exact, any device)
+  image,   // an OpenCL 3D image with the sampler's linear filtering (hardware on GPUs)
+};
+
+// Quality choices of the pass; each is a kernel build option (docs/volumetric.md §Variants).
+struct VolumeSettings {
+  VolumeIntegrator integrator = VolumeIntegrator::stylized;
+  int steps = 50;                        // march steps per ray, in [1, 4096]; the seed's 50
+  int resolution_divisor = 2;            // 1 full, 2 half (the seed's), 4 quarter
+  VolumeUpsampling upsampling = VolumeUpsampling::depth_aware;
+  bool jitter = true;                    // per-ray start jitter from (pixel, frame index)
+  bool adaptive_steps = true;            // stylized: the seed's step refinement at fog onset
+  int noise_size = 64;                   // noise texels per side: 32, 64 or 128
+  std::uint32_t noise_seed = 1;
+  NoiseSampling noise_sampling = NoiseSampling::buffer;
+};
+
+// What changes from frame to frame.
+struct VolumeScene {
+  std::vector<FogVolume> volumes;
+  CameraPose pose;
+  MainLight light;
+  float time = 0.0f;                     // [s], finite: noise scrolls by speed * time
+  std::uint32_t frame_index = 0;         // seeds the per-ray jitter
+};
+
+// Throw fogcl::Error naming the value (and the volume's index) and the rule.
+void validate(const FogVolume& volume, std::size_t index = 0);
+void validate(const CameraPose& pose);
+void validate(const MainLight& light);
+void validate(const ShadowMapParams& shadow);
+void validate(const VolumeSettings& settings);
+void validate(const VolumeScene& scene);
+
+const char* to_string(VolumeIntegrator integrator);
+const char* to_string(VolumeUpsampling upsampling);
+const char* to_string(NoiseSampling sampling);
+
+}  // namespace fogcl

@@ -1,0 +1,346 @@
+#include "volume/volume_params.h"
+
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <sstream>
+
+#include <glm/geometric.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/matrix.hpp>
+
+#include "fogcl/error.h"
+#include "fogcl/volume_pass.h"
+#include "volume/volume_formulas.h"
+
+namespace fogcl {
+
+namespace {
+std::string str(double v) {
+  std::ostringstream s;
+  s.precision(9);
+  s << v;
+  return s.str();
+}
+std::string str(const glm::vec3& v) { return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ")"; }
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Checks of one volume: "volume 2: radius must be finite and > 0 (got -1)".
+struct VolumeChecker {
+  std::string where;
+  void fail(const char* key, const std::string& rule, const std::string& got) const {
+    throw Error(where + key + " " + rule + " (got " + got + ")");
+  }
+  void real(const char* key, float v, float lo, bool lo_open, float hi, bool hi_open, const char* rule) const {
+    const bool ok = std::isfinite(v) && (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+    if (!ok) fail(key, rule, str(v));
+  }
+  void vec(const char* key, const glm::vec3& v, float lo, float hi, const char* rule) const {
+    for (int k = 0; k < 3; ++k)
+      if (!(std::isfinite(v[k]) && v[k] >= lo && v[k] <= hi)) fail(key, rule, str(v));
+  }
+  void color(const char* key, const glm::vec4& c) const {
+    for (int k = 0; k < 4; ++k)
+      if (!(std::isfinite(c[k]) && c[k] >= 0.0f && c[k] <= 65504.0f))
+        fail(key, "must be RGBA with each component in [0, 65504]",
+             "(" + str(c.r) + ", " + str(c.g) + ", " + str(c.b) + ", " + str(c.a) + ")");
+  }
+};
+constexpr float kInf = INFINITY;
+constexpr float kBig = 3.4e38f;
+}  // namespace
+
+void validate(const FogVolume& v, std::size_t index) {
+  const VolumeChecker c{"volume " + std::to_string(index) + ": "};
+  c.vec("center", v.center, -kBig, kBig, "must be finite");
+  c.real("radius", v.radius, 0.0f, true, kBig, false, "must be finite and > 0");
+  c.real("density", v.density, 0.0f, false, kBig, false, "must be finite and >= 0");
+  c.real("max_y", v.max_y, -kBig, false, kBig, false, "must be finite");
+  c.real("fade_y", v.fade_y, 0.0f, false, kBig, false, "must be finite and >= 0 (0: no fade)");
+  c.real("fade_edge", v.fade_edge, 0.0f, false, kBig, false, "must be finite and >= 0 (0: no fade)");
+  c.real("proximity_fade", v.proximity_fade, 0.0f, false, kBig, false, "must be finite and >= 0 (0: no fade)");
+  c.real("fog_exponent", v.fog_exponent, 0.0f, true, kBig, false, "must be finite and > 0");
+  c.real("fog_cutoff", v.fog_cutoff, 0.0f, false, 1.0f, true, "must be in [0, 1)");
+  c.real("detail_exponent", v.detail_exponent, 0.0f, true, kBig, false, "must be finite and > 0");
+  c.real("detail_strength", v.detail_strength, 0.0f, false, 1.0f, false, "must be in [0, 1]");
+  c.color("fog_color", v.fog_color);
+  c.color("directional_fog_color", v.directional_fog_color);
+  c.real("directional_falloff", v.directional_falloff, 0.0f, true, kBig, false, "must be finite and > 0");
+  c.real("light_contribution", v.light_contribution, 0.0f, false, kBig, false, "must be finite and >= 0");
+  c.real("directional_light_contribution", v.directional_light_contribution, 0.0f, false, kBig, false,
+         "must be finite and >= 0");
+  c.real("shadow_strength", v.shadow_strength, 0.0f, false, kBig, false, "must be finite and >= 0");
+  c.real("shadow_reverse_strength", v.shadow_reverse_strength, 0.0f, false, kBig, false, "must be finite and >= 0");
+  c.vec("tiling", v.tiling, -kBig, kBig, "must be finite");
+  c.vec("speed", v.speed, -kBig, kBig, "must be finite");
+  c.vec("detail_tiling", v.detail_tiling, -kBig, kBig, "must be finite");
+  c.real("detail_speed_modifier", v.detail_speed_modifier, -kBig, false, kBig, false, "must be finite");
+  c.real("occluder_overshoot", v.occluder_overshoot, 0.0f, false, kBig, false, "must be finite and >= 0");
+  if (v.albedo) c.vec("albedo", *v.albedo, 0.0f, 1.0f, "must be RGB with each component in [0, 1]");
+  c.real("anisotropy", v.anisotropy, -1.0f, true, 1.0f, true, "must be in (-1, 1)");
+  if (v.ambient) c.vec("ambient", *v.ambient, 0.0f, kBig, "must be RGB, finite and >= 0");
+}
+
+void validate(const CameraPose& p) {
+  if (!finite(p.eye)) throw Error("camera eye must be finite (got " + str(p.eye) + ")");
+  if (!finite(p.forward) || glm::length(p.forward) == 0.0f)
+    throw Error("camera forward must be a finite non-zero vector (got " + str(p.forward) + ")");
+  if (!finite(p.up) || glm::length(p.up) == 0.0f)
+    throw Error("camera up must be a finite non-zero vector (got " + str(p.up) + ")");
+  const glm::dvec3 f = glm::normalize(glm::dvec3(p.forward)), u = glm::normalize(glm::dvec3(p.up));
+  if (glm::length(glm::cross(u, f)) < 1e-4)
+    throw Error("camera up " + str(p.up) + " must not be parallel to forward " + str(p.forward));
+}
+
+void validate(const MainLight& l) {
+  if (!finite(l.direction) || glm::length(l.direction) == 0.0f)
+    throw Error("light direction must be a finite non-zero vector (got " + str(l.direction) + ")");
+  for (int k = 0; k < 3; ++k)
+    if (!(std::isfinite(l.color[k]) && l.color[k] >= 0.0f))
+      throw Error("light color must be RGB, finite and >= 0 (got " + str(l.color) + ")");
+}
+
+void validate(const ShadowMapParams& s) {
+  const glm::mat4& m = s.world_to_light_clip;
+  double scale = 0.0;
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) {
+      if (!std::isfinite(m[c][r]))
+        throw Error("light view-projection matrix element (row " + std::to_string(r) + ", column " +
+                    std::to_string(c) + ") is not finite (got " + str(m[c][r]) + ")");
+      scale = std::fmax(scale, std::fabs(double(m[c][r])));
+    }
+  const double det = glm::determinant(glm::dmat4(m));
+  if (scale == 0.0 || !(std::fabs(det) > 1e-12 * std::pow(scale, 4)))
+    throw Error("light view-projection matrix is singular (determinant " + str(det) +
+                "): it must map world space one-to-one to light clip space");
+  if (!(std::isfinite(s.bias) && s.bias >= 0.0f))
+    throw Error("shadow bias must be finite and >= 0 (got " + str(s.bias) + ")");
+}
+
+void validate(const VolumeSettings& s) {
+  if (s.steps < 1 || s.steps > 4096) throw Error("volume steps must be in [1, 4096] (got " + std::to_string(s.steps) + ")");
+  if (s.resolution_divisor != 1 && s.resolution_divisor != 2 && s.resolution_divisor != 4)
+    throw Error("volume resolution divisor must be 1 (full), 2 (half) or 4 (quarter) (got " +
+                std::to_string(s.resolution_divisor) + ")");
+  if (s.noise_size != 32 && s.noise_size != 64 && s.noise_size != 128)
+    throw Error("noise size must be 32, 64 or 128 (got " + std::to_string(s.noise_size) + ")");
+}
+
+void validate(const VolumeScene& s) {
+  for (std::size_t i = 0; i < s.volumes.size(); ++i) validate(s.volumes[i], i);
+  validate(s.pose);
+  validate(s.light);
+  if (!std::isfinite(s.time)) throw Error("time must be finite (got " + str(s.time) + ")");
+}
+
+const char* to_string(VolumeIntegrator i) { return i == VolumeIntegrator::stylized ? "stylized" : "physical"; }
+const char* to_string(VolumeUpsampling u) { return u == VolumeUpsampling::depth_aware ? "depth-aware" : "bilinear"; }
+const char* to_string(NoiseSampling s) { return s == NoiseSampling::buffer ? "buffer" : "image"; }
+
+namespace {
+// The camera's rotation, view -> world (docs/volumetric.md §World): columns right, up', forward.
+struct Basis {
+  glm::vec3 right, up, forward;
+};
+Basis camera_basis(const CameraPose& p) {
+  const glm::dvec3 f = glm::normalize(glm::dvec3(p.forward));
+  const glm::dvec3 r = glm::normalize(glm::cross(glm::dvec3(p.up), f));
+  return {glm::vec3(r), glm::vec3(glm::cross(f, r)), glm::vec3(f)};
+}
+
+// Culling in view space: side planes through the corner rays (or the orthographic box), near
+// and far, and the depth buffer's farthest surface.
+bool volume_visible(const FogVolume& v, const Basis& b, const CameraPose& pose, const CameraParams& cam,
+                    float max_eye_depth) {
+  const glm::dvec3 d = glm::dvec3(v.center) - glm::dvec3(pose.eye);
+  const glm::dvec3 c(glm::dot(d, glm::dvec3(b.right)), glm::dot(d, glm::dvec3(b.up)), glm::dot(d, glm::dvec3(b.forward)));
+  const double r = v.radius, n = cam.near_plane();
+  // No far-plane test: sky pixels see infinitely far (t_scene = +inf, docs/volumetric.md §World),
+  // so a volume beyond the far plane still shows against the sky; the depth range hides it
+  // wherever no pixel is sky.
+  if (c.z + r < n) return false;
+  if (c.z - r >= double(max_eye_depth)) return false;
+  const auto& k = cam.frustum_corners;
+  if (cam.projection == Projection::orthographic)
+    return std::fabs(c.x) - r <= double(k[kTopRight].x) && std::fabs(c.y) - r <= double(k[kTopRight].y);
+  // (edge a, edge b, a corner on the inside)
+  const int planes[4][3] = {{kBottomLeft, kTopLeft, kBottomRight}, {kBottomRight, kTopRight, kBottomLeft},
+                            {kBottomLeft, kBottomRight, kTopLeft}, {kTopLeft, kTopRight, kBottomLeft}};
+  for (const auto& p : planes) {
+    glm::dvec3 normal = glm::normalize(glm::cross(glm::dvec3(k[p[0]]), glm::dvec3(k[p[1]])));
+    if (glm::dot(normal, glm::dvec3(k[p[2]])) < 0) normal = -normal;
+    if (glm::dot(normal, c) < -r) return false;
+  }
+  return true;
+}
+}  // namespace
+
+std::vector<std::size_t> visible_volumes(const VolumeScene& scene, const CameraParams& camera, float max_eye_depth) {
+  validate(scene);
+  validate(camera);
+  const Basis b = camera_basis(scene.pose);
+  std::vector<std::size_t> visible;
+  for (std::size_t i = 0; i < scene.volumes.size(); ++i)
+    if (volume_visible(scene.volumes[i], b, scene.pose, camera, max_eye_depth)) visible.push_back(i);
+  return visible;
+}
+
+float max_eye_depth(const DepthImage& depth, const CameraParams& camera) {
+  validate(camera);
+  const float zx = camera.zbuffer_params.x, zy = camera.zbuffer_params.y;
+  float farthest = 0.0f;
+  for (std::size_t i = 0; i < depth.pixel_count(); ++i) {
+    const float e = volume_formulas::vol_eye_depth(depth.data()[i], int(camera.projection), camera.reversed_z, zx, zy,
+                                                   camera.near_plane(), camera.far_plane());
+    if (!(e < kInf)) return kInf;
+    farthest = std::fmax(farthest, e);
+  }
+  return farthest;
+}
+
+namespace detail {
+
+bool PackedVolumeFrame::needs_noise() const { return (variant.features & VOL_FEATURE_NOISE) != 0; }
+
+PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& camera, const VolumeScene& scene,
+                                    const VolumeSettings& settings, ColorFormat storage,
+                                    const ShadowMapParams* shadow, int shadow_width, int shadow_height,
+                                    float max_eye_depth) {
+  if (width < 1 || height < 1)
+    throw Error("frame size must be at least 1x1 (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
+  validate(settings);
+  if (shadow) {
+    validate(*shadow);
+    if (shadow_width < 1 || shadow_height < 1)
+      throw Error("shadow map size must be at least 1x1 (got " + std::to_string(shadow_width) + "x" +
+                  std::to_string(shadow_height) + ")");
+  }
+  PackedVolumeFrame out;
+  out.visible = visible_volumes(scene, camera, max_eye_depth);  // validates scene and camera
+  if (out.visible.size() > VOL_MAX_VOLUMES)
+    throw Error(std::to_string(out.visible.size()) + " fog volumes are visible in this frame; at most " +
+                std::to_string(VOL_MAX_VOLUMES) + " are supported");
+  const int s = settings.resolution_divisor;
+  out.low_width = (width + s - 1) / s;
+  out.low_height = (height + s - 1) / s;
+
+  VolumeVariant& v = out.variant;
+  v.integrator = settings.integrator;
+  v.steps = settings.steps;
+  v.jitter = settings.jitter;
+  v.projection = camera.projection;
+  v.reversed_z = camera.reversed_z;
+  v.noise_sampling = settings.noise_sampling;
+  v.scale = s;
+  v.depth_aware = settings.upsampling == VolumeUpsampling::depth_aware;
+  v.storage = storage;
+  if (settings.integrator == VolumeIntegrator::stylized && settings.adaptive_steps) v.features |= VOL_FEATURE_ADAPTIVE;
+  if (shadow) v.features |= VOL_FEATURE_SHADOW | (shadow->reversed_z ? VOL_FEATURE_SHADOW_REVERSED : 0);
+
+  const glm::vec3 light_dir = glm::normalize(scene.light.direction);
+  for (std::size_t index : out.visible) {
+    const FogVolume& f = scene.volumes[index];
+    if (f.noise) v.features |= VOL_FEATURE_NOISE;
+    if (f.noise && f.detail_strength > 0.0f) v.features |= VOL_FEATURE_DETAIL;
+    if (f.fade_edge > 0.0f || f.fade_y > 0.0f || f.proximity_fade > 0.0f || f.max_y < f.center.y + f.radius)
+      v.features |= VOL_FEATURE_FADES;
+    float p[VOL_V_STRIDE] = {};
+    const auto put3 = [&](int at, const glm::vec3& x) { p[at] = x.x, p[at + 1] = x.y, p[at + 2] = x.z; };
+    const auto put4 = [&](int at, const glm::vec4& x) { put3(at, glm::vec3(x)), p[at + 3] = x.w; };
+    put3(VOL_V_CENTER, f.center);
+    p[VOL_V_RADIUS] = f.radius;
+    p[VOL_V_DENSITY] = f.density;
+    p[VOL_V_MAX_Y] = f.max_y;
+    p[VOL_V_FADE_Y] = f.fade_y;
+    p[VOL_V_FADE_EDGE] = f.fade_edge;
+    p[VOL_V_PROXIMITY_FADE] = f.proximity_fade;
+    p[VOL_V_FOG_EXPONENT] = f.fog_exponent;
+    p[VOL_V_FOG_CUTOFF] = f.fog_cutoff;
+    p[VOL_V_DETAIL_EXPONENT] = f.detail_exponent;
+    p[VOL_V_DETAIL_STRENGTH] = f.detail_strength;
+    put4(VOL_V_FOG_COLOR, f.fog_color);
+    put4(VOL_V_DIR_FOG_COLOR, f.directional_fog_color);
+    p[VOL_V_DIR_FALLOFF] = f.directional_falloff;
+    p[VOL_V_LIGHT_CONTRIBUTION] = f.light_contribution;
+    p[VOL_V_DIR_LIGHT_CONTRIBUTION] = f.directional_light_contribution;
+    p[VOL_V_SHADOW_STRENGTH] = f.shadow_strength;
+    p[VOL_V_SHADOW_REVERSE_STRENGTH] = f.shadow_reverse_strength;
+    put3(VOL_V_TILING, f.tiling);
+    put3(VOL_V_SPEED, f.speed);
+    put3(VOL_V_DETAIL_TILING, f.detail_tiling);
+    p[VOL_V_DETAIL_SPEED_MODIFIER] = f.detail_speed_modifier;
+    p[VOL_V_OVERSHOOT] = f.occluder_overshoot;
+    p[VOL_V_NOISE] = f.noise ? 1.0f : 0.0f;
+    put3(VOL_V_ALBEDO, f.albedo.value_or(glm::vec3(f.fog_color)));
+    p[VOL_V_ANISOTROPY] = f.anisotropy;
+    put3(VOL_V_AMBIENT, f.ambient.value_or(0.1f * scene.light.color));
+    out.volumes.insert(out.volumes.end(), p, p + VOL_V_STRIDE);
+  }
+
+  float* k = out.frame.data();
+  const Basis b = camera_basis(scene.pose);
+  const auto put3 = [&](int at, const glm::vec3& x) { k[at] = x.x, k[at + 1] = x.y, k[at + 2] = x.z; };
+  put3(VOL_F_EYE, scene.pose.eye);
+  put3(VOL_F_RIGHT, b.right);
+  put3(VOL_F_UP, b.up);
+  put3(VOL_F_FORWARD, b.forward);
+  for (int c = 0; c < 4; ++c) put3(VOL_F_CORNERS + 3 * c, camera.frustum_corners[c]);
+  k[VOL_F_NEAR] = camera.near_plane();
+  k[VOL_F_FAR] = camera.far_plane();
+  k[VOL_F_ZX] = camera.zbuffer_params.x;
+  k[VOL_F_ZY] = camera.zbuffer_params.y;
+  k[VOL_F_CORNER_Z] = camera.frustum_corners[kBottomLeft].z;
+  put3(VOL_F_LIGHT_DIR, light_dir);
+  put3(VOL_F_LIGHT_COLOR, scene.light.color);
+  k[VOL_F_TIME] = scene.time;
+  k[VOL_F_WIDTH] = float(width);
+  k[VOL_F_HEIGHT] = float(height);
+  k[VOL_F_SCALE] = float(s);
+  k[VOL_F_LOW_WIDTH] = float(out.low_width);
+  k[VOL_F_LOW_HEIGHT] = float(out.low_height);
+  if (shadow) {
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) k[VOL_F_SHADOW_MATRIX + 4 * c + r] = shadow->world_to_light_clip[c][r];
+    k[VOL_F_SHADOW_WIDTH] = float(shadow_width);
+    k[VOL_F_SHADOW_HEIGHT] = float(shadow_height);
+    k[VOL_F_SHADOW_BIAS] = shadow->bias;
+  }
+  return out;
+}
+
+std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& device) {
+  std::string o = cl_std_option(device);
+  o += " -D VOL_INTEGRATOR=" + std::to_string(v.integrator == VolumeIntegrator::stylized ? VOL_STYLIZED : VOL_PHYSICAL);
+  o += " -D VOL_STEPS=" + std::to_string(v.steps);
+  o += " -D VOL_FEATURES=" + std::to_string(v.features);
+  o += " -D VOL_JITTER=" + std::to_string(v.jitter ? 1 : 0);
+  o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
+  if (v.reversed_z) o += " -D REVERSED_Z";
+  if (v.noise_sampling == NoiseSampling::image && (v.features & VOL_FEATURE_NOISE)) o += " -D VOL_NOISE_IMAGE";
+  return o;
+}
+
+std::string volume_composite_options(const VolumeVariant& v, const DeviceTraits& device) {
+  std::string o = cl_std_option(device);
+  o += " -D VOL_SCALE=" + std::to_string(v.scale);
+  o += " -D VOL_DEPTH_AWARE=" + std::to_string(v.depth_aware ? 1 : 0);
+  o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
+  if (v.reversed_z) o += " -D REVERSED_Z";
+  if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
+  return o;
+}
+
+const NoiseTexture& shared_noise_texture(int size, std::uint32_t seed) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, std::uint32_t>, std::unique_ptr<NoiseTexture>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{size, seed}];
+  if (!slot) slot = std::make_unique<NoiseTexture>(make_noise_texture(size, seed));
+  return *slot;
+}
+
+}  // namespace detail
+}  // namespace fogcl

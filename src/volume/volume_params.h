@@ -1,0 +1,55 @@
+// What the host hands the volumetric kernels and the scalar path alike: the packed per-frame and
+// per-volume arrays (layouts in kernels/volume_common.h), the variant a frame needs and its
+// build options, and the process-wide noise textures.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fogcl/camera.h"
+#include "fogcl/image.h"
+#include "fogcl/noise.h"
+#include "fogcl/variant.h"
+#include "fogcl/volumes.h"
+
+namespace fogcl::detail {
+
+// Everything a frame's march and composite are specialised on.
+struct VolumeVariant {
+  VolumeIntegrator integrator = VolumeIntegrator::stylized;
+  int steps = 50;
+  int features = 0;           // VOL_FEATURE_* bits
+  bool jitter = true;
+  Projection projection = Projection::perspective;
+  bool reversed_z = false;
+  NoiseSampling noise_sampling = NoiseSampling::buffer;
+  int scale = 2;
+  bool depth_aware = true;
+  ColorFormat storage = ColorFormat::rgba32f;
+};
+
+// A frame ready to march: the visible volumes packed, the frame constants, the variant.
+struct PackedVolumeFrame {
+  std::array<float, 64> frame{};   // VOL_F_COUNT floats
+  std::vector<float> volumes;      // VOL_V_STRIDE floats per visible volume
+  std::vector<std::size_t> visible;  // indices into scene.volumes
+  VolumeVariant variant;
+  int low_width = 0, low_height = 0;
+  bool needs_noise() const;
+};
+
+// Validates everything and packs the frame (culling with max_eye_depth). Throws fogcl::Error.
+PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& camera, const VolumeScene& scene,
+                                    const VolumeSettings& settings, ColorFormat storage,
+                                    const ShadowMapParams* shadow, int shadow_width, int shadow_height,
+                                    float max_eye_depth);
+
+std::string volume_march_options(const VolumeVariant& variant, const DeviceTraits& device);
+std::string volume_composite_options(const VolumeVariant& variant, const DeviceTraits& device);
+
+// The noise texture of (size, seed), generated once per process and shared (thread-safe).
+const NoiseTexture& shared_noise_texture(int size, std::uint32_t seed);
+
+}  // namespace fogcl::detail

@@ -1,0 +1,116 @@
+#include "fogcl/volume_scalar.h"
+
+#include <cmath>
+#include <cstring>
+
+#include <Imath/half.h>
+
+#include "fogcl/error.h"
+#include "fogcl/volume_pass.h"
+#include "volume/volume_formulas.h"
+#include "volume/volume_params.h"
+
+namespace fogcl {
+
+template <class T>
+VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& camera,
+                               const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
+  using namespace volume_formulas;
+  validate_frame(in, depth);
+  const int w = in.width(), h = in.height();
+  const detail::PackedVolumeFrame f = detail::pack_volume_frame(
+      w, h, camera, scene, settings, in.format(), shadow ? &shadow->params : nullptr,
+      shadow ? shadow->depth.width() : 0, shadow ? shadow->depth.height() : 0, max_eye_depth(depth, camera));
+  VolumeResult<T> r;
+  r.width = w;
+  r.height = h;
+  r.visible = f.visible.size();
+  r.rgba.resize(4 * in.pixel_count());
+  r.coverage.assign(in.pixel_count(), T(0));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const glm::vec4 c = in.pixel(x, y);
+      for (int k = 0; k < 4; ++k) r.rgba[4 * (std::size_t(y) * w + x) + k] = T(c[k]);
+    }
+  if (f.visible.empty()) return r;
+
+  const detail::VolumeVariant& v = f.variant;
+  const std::uint8_t* noise = f.needs_noise()
+                                  ? detail::shared_noise_texture(settings.noise_size, settings.noise_seed).texels.data()
+                                  : nullptr;
+  const int projection = int(v.projection), reversed = v.reversed_z;
+  const float* shadow_map = shadow ? shadow->depth.data() : nullptr;
+  const int integrator = v.integrator == VolumeIntegrator::stylized ? VOL_STYLIZED : VOL_PHYSICAL;
+  r.low_width = f.low_width;
+  r.low_height = f.low_height;
+  r.low.resize(4 * std::size_t(f.low_width) * f.low_height);
+  r.low_key.resize(std::size_t(f.low_width) * f.low_height);
+  for (int ly = 0; ly < f.low_height; ++ly)
+    for (int lx = 0; lx < f.low_width; ++lx) {
+      const std::size_t i = std::size_t(ly) * f.low_width + lx;
+      T key;
+      const glm::vec<4, T> p = vol_march_pixel<T>(
+          lx, ly, depth.data(), f.frame.data(), f.volumes.data(), int(f.visible.size()), noise, settings.noise_size,
+          shadow_map, scene.frame_index, integrator, v.steps, v.features, v.jitter, projection, reversed, &key);
+      for (int k = 0; k < 4; ++k) r.low[4 * i + k] = p[k];
+      r.low_key[i] = key;
+    }
+  const float* k = f.frame.data();
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      const T key = v.depth_aware && v.scale > 1
+                        ? vol_eye_depth(T(depth.data()[i]), projection, reversed, T(k[VOL_F_ZX]), T(k[VOL_F_ZY]),
+                                        T(k[VOL_F_NEAR]), T(k[VOL_F_FAR]))
+                        : T(0);
+      const glm::vec<4, T> fog =
+          vol_upsample(x, y, key, r.low.data(), r.low_key.data(), f.low_width, f.low_height, v.scale, v.depth_aware);
+      r.coverage[i] = fog.w;
+      if (fog.w == T(0)) continue;
+      for (int c = 0; c < 3; ++c) r.rgba[4 * i + c] = vol_composite(r.rgba[4 * i + c], fog[c], fog.w);
+    }
+  return r;
+}
+
+template VolumeResult<float> volumes_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,
+                                                   const VolumeScene&, const VolumeSettings&, const ShadowMap*);
+template VolumeResult<double> volumes_scalar<double>(const ColorImage&, const DepthImage&, const CameraParams&,
+                                                     const VolumeScene&, const VolumeSettings&, const ShadowMap*);
+
+void apply_volumes_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
+                          const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
+  const VolumeResult<float> r = volumes_scalar<float>(in, depth, camera, scene, settings, shadow);
+  ColorImage result = in;  // A == 0 pixels and alpha keep their bits
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x) {
+      const std::size_t i = std::size_t(y) * in.width() + x;
+      if (r.coverage[i] == 0.0f) continue;
+      const glm::vec4 o(r.rgba[4 * i], r.rgba[4 * i + 1], r.rgba[4 * i + 2], 0.0f);
+      if (in.format() == ColorFormat::rgba16f) {
+        std::uint16_t* p = result.rgba16f() + 4 * i;
+        for (int k = 0; k < 3; ++k) p[k] = Imath::half(o[k]).bits();
+      } else {
+        float* p = result.rgba32f() + 4 * i;
+        for (int k = 0; k < 3; ++k) p[k] = o[k];
+      }
+    }
+  out = std::move(result);
+}
+
+double max_abs_rgb_error(const ColorImage& image, const VolumeResult<double>& ref) {
+  if (image.width() != ref.width || image.height() != ref.height)
+    throw Error("max_abs_rgb_error: image and reference sizes differ");
+  double worst = 0.0;
+  for (int y = 0; y < ref.height; ++y)
+    for (int x = 0; x < ref.width; ++x) {
+      const glm::vec4 c = image.pixel(x, y);
+      for (int k = 0; k < 3; ++k) {
+        const double d = std::fabs(double(c[k]) - ref.rgba[4 * (std::size_t(y) * ref.width + x) + k]);
+        worst = std::isnan(d) ? INFINITY : std::fmax(worst, d);
+        if (std::isinf(worst)) return worst;
+      }
+    }
+  return worst;
+}
+
+}  // namespace fogcl
