@@ -7,6 +7,7 @@
 #include "fogcl/fog_pass.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
+#include "fogcl/noise.h"
 #include "fogcl/runtime.h"
 #include "fogcl/scalar.h"
 #include "fogcl/variant.h"
