@@ -15,6 +15,34 @@ CameraPose pose_of(const DemoView& view) {
   return p;
 }
 
+ShadowMap synthetic_shadow_map(bool reversed_z) {
+  constexpr int kSize = 128;
+  constexpr float kHalf = 15.0f, kCz = 4.0f, kTop = 10.0f, kBottom = -1.0f;
+  ShadowMap m;
+  glm::mat4& p = m.params.world_to_light_clip;
+  p = glm::mat4(0.0f);
+  p[0][0] = 1.0f / kHalf;              // clip x from world x
+  p[2][1] = 1.0f / kHalf;              // clip y from world z
+  p[3][1] = -kCz / kHalf;
+  p[1][2] = -1.0f / (kTop - kBottom);  // depth 0 at the top, 1 at the bottom
+  p[3][2] = kTop / (kTop - kBottom);
+  p[3][3] = 1.0f;
+  if (reversed_z) {
+    p[1][2] = -p[1][2];
+    p[3][2] = 1.0f - p[3][2];
+  }
+  m.params.reversed_z = reversed_z;
+  m.depth = DepthImage(kSize, kSize);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const float wx = ((x + 0.5f) / kSize * 2 - 1) * kHalf, wz = (1 - (y + 0.5f) / kSize * 2) * kHalf + kCz;
+      const float height = wx * wx + wz * wz < 9.0f ? 2.0f : 0.0f;
+      const float d = (kTop - height) / (kTop - kBottom);
+      m.depth.at(x, y) = reversed_z ? 1.0f - d : d;
+    }
+  return m;
+}
+
 VolumeTestScene volume_test_scene(int width, int height, ColorFormat format, bool reversed_z) {
   VolumeTestScene s;
   PerspectiveCamera camera;

@@ -21,6 +21,10 @@ struct VolumeTestScene {
 VolumeTestScene volume_test_scene(int width, int height, ColorFormat format = ColorFormat::rgba32f,
                                   bool reversed_z = false);
 
+// A top-down shadow map (light looking along -y, orthographic over x, z in [-15, 15] + (0, 4)):
+// a disc blocker of radius 3 at height 2 above (0, 0); the ground (height 0) elsewhere.
+ShadowMap synthetic_shadow_map(bool reversed_z);
+
 // The pose of a DemoView (forward = target - eye, up = +y).
 CameraPose pose_of(const DemoView& view);
 

@@ -1,0 +1,150 @@
+// The volumetric pass's integration API (the caller's queue and buffers, wait list in, event out),
+// the host-side culling, and nothing visible = no dispatch and the input bit for bit.
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "volume_support.h"
+
+namespace fogcl::test {
+namespace {
+
+class VolumeIntegration : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    FOGCL_REQUIRE_DEVICE();
+    ctx = runtime()->context();
+    queue = cl::CommandQueue(ctx, runtime()->device());
+    t = volume_test_scene(80, 45);
+    settings.steps = 16;
+  }
+  FrameBuffers buffers(bool in_place) {
+    FrameBuffers fb;
+    fb.width = t.frame.color.width();
+    fb.height = t.frame.color.height();
+    fb.color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, t.frame.color.size_bytes(),
+                             const_cast<void*>(t.frame.color.data()));
+    fb.depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, t.frame.depth.size_bytes(),
+                          const_cast<float*>(t.frame.depth.data()));
+    fb.color_out = in_place ? fb.color_in : cl::Buffer(ctx, CL_MEM_READ_WRITE, t.frame.color.size_bytes());
+    return fb;
+  }
+  ColorImage read(const cl::Buffer& b) {
+    ColorImage out(t.frame.color.width(), t.frame.color.height());
+    queue.enqueueReadBuffer(b, CL_TRUE, 0, out.size_bytes(), out.data());
+    return out;
+  }
+  cl::Context ctx;
+  cl::CommandQueue queue;
+  VolumeTestScene t;
+  VolumeSettings settings;
+};
+
+TEST_F(VolumeIntegration, WaitsOnCallerEventsNeverBlocksAndMatchesTheConvenienceApi) {
+  VolumePass pass(ctx, runtime()->device());
+  pass.prepare(t.frame.params, t.scene, settings, ColorFormat::rgba32f);
+  const FrameBuffers fb = buffers(false);
+  cl::UserEvent gate(ctx);
+  // A hidden finish inside enqueue would hang here: the gate opens only below.
+  const cl::Event done = pass.enqueue(queue, fb, t.frame.params, t.scene, settings, nullptr, {gate});
+  EXPECT_NE(done.getInfo<CL_EVENT_COMMAND_EXECUTION_STATUS>(), CL_COMPLETE);
+  EXPECT_EQ(pass.stats().march_dispatches, 1u);
+  EXPECT_EQ(pass.stats().composite_dispatches, 1u);
+  gate.setStatus(CL_COMPLETE);
+  done.wait();
+  const ColorImage got = read(fb.color_out);
+  ColorImage expected;
+  VolumePass(*runtime()).apply(t.frame.color, t.frame.depth, expected, t.frame.params, t.scene, settings);
+  EXPECT_EQ(std::memcmp(got.data(), expected.data(), got.size_bytes()), 0);
+  // In place gives the same bytes.
+  const FrameBuffers in_place = buffers(true);
+  pass.enqueue(queue, in_place, t.frame.params, t.scene, settings).wait();
+  const ColorImage got_in_place = read(in_place.color_out);
+  EXPECT_EQ(std::memcmp(got_in_place.data(), expected.data(), got.size_bytes()), 0);
+  EXPECT_EQ(pass.stats().noise_uploads, 1u) << "the noise texture is uploaded once and reused";
+}
+
+TEST_F(VolumeIntegration, NothingVisibleMeansNoDispatchAndTheInputBitForBit) {
+  // One volume behind the camera, one far off to the side: the frustum culls both.
+  FogVolume behind = t.scene.volumes[0];
+  behind.center = t.scene.pose.eye - 20.0f * glm::normalize(t.scene.pose.forward);
+  behind.radius = 2.0f;
+  FogVolume aside = behind;
+  aside.center = t.scene.pose.eye + glm::vec3(300.0f, 0.0f, 50.0f);
+  t.scene.volumes = {behind, aside};
+  // Some sky and NaN colors: the bits must survive.
+  float* c = t.frame.color.rgba32f();
+  c[0] = std::numeric_limits<float>::quiet_NaN();
+  c[5] = INFINITY;
+  VolumePass pass(ctx, runtime()->device());
+  const FrameBuffers fb = buffers(false);
+  pass.enqueue(queue, fb, t.frame.params, t.scene, settings).wait();
+  EXPECT_EQ(pass.stats().march_dispatches, 0u);
+  EXPECT_EQ(pass.stats().frames_without_volumes, 1u);
+  EXPECT_EQ(pass.stats().volumes_culled, 2u);
+  const ColorImage got = read(fb.color_out);
+  EXPECT_EQ(std::memcmp(got.data(), t.frame.color.data(), got.size_bytes()), 0);
+  ColorImage out;
+  VolumePass convenience(*runtime());
+  convenience.apply(t.frame.color, t.frame.depth, out, t.frame.params, t.scene, settings);
+  EXPECT_EQ(convenience.stats().march_dispatches, 0u);
+  EXPECT_EQ(std::memcmp(out.data(), t.frame.color.data(), out.size_bytes()), 0);
+  ColorImage scalar_out;
+  apply_volumes_scalar(t.frame.color, t.frame.depth, scalar_out, t.frame.params, t.scene, settings);
+  EXPECT_EQ(std::memcmp(scalar_out.data(), t.frame.color.data(), out.size_bytes()), 0);
+}
+
+TEST(VolumeCulling, FrustumAndDepthRange) {
+  const VolumeTestScene t = volume_test_scene(64, 36);
+  VolumeScene s = t.scene;
+  FogVolume v;
+  v.radius = 1.0f;
+  const glm::vec3 eye = s.pose.eye, f = glm::normalize(s.pose.forward);
+  const auto visible = [&](glm::vec3 center, float max_eye) {
+    v.center = center;
+    s.volumes = {v};
+    return !visible_volumes(s, t.frame.params, max_eye).empty();
+  };
+  EXPECT_TRUE(visible(eye + 10.0f * f, INFINITY));
+  EXPECT_FALSE(visible(eye - 10.0f * f, INFINITY)) << "behind the camera";
+  EXPECT_TRUE(visible(eye + 0.5f * f, INFINITY)) << "the camera inside";
+  EXPECT_FALSE(visible(eye + 10.0f * f + glm::vec3(30.0f, 0.0f, 0.0f), INFINITY)) << "off to the right";
+  EXPECT_TRUE(visible(eye + 10.0f * f + glm::vec3(6.0f, 0.0f, 0.0f), INFINITY)) << "partly on screen";
+  EXPECT_FALSE(visible(eye + 10.0f * f, 5.0f)) << "wholly behind the farthest surface";
+  EXPECT_TRUE(visible(eye + 10.0f * f, 9.5f)) << "its front is nearer than the farthest surface";
+  EXPECT_TRUE(visible(eye + 500.0f * f, INFINITY)) << "beyond the far plane, against the sky";
+  // max_eye_depth: +inf with sky, finite without.
+  EXPECT_TRUE(std::isinf(max_eye_depth(t.frame.depth, t.frame.params)));
+  DepthImage ground(4, 4, 0.5f);
+  EXPECT_LT(max_eye_depth(ground, t.frame.params), t.frame.params.far_plane());
+}
+
+TEST(VolumeValidation, BadInputNamesTheValueAndTheRule) {
+  VolumeScene s;
+  s.volumes.resize(2);
+  s.volumes[1].radius = -1.0f;
+  EXPECT_MSG_HAS(error_of([&] { validate(s); }), "volume 1: radius must be finite and > 0 (got -1)");
+  s.volumes[1].radius = 1.0f;
+  s.volumes[0].density = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_MSG_HAS(error_of([&] { validate(s); }), "volume 0: density");
+  s.volumes[0].density = 1e20f;  // stiff, but valid
+  validate(s);
+  s.pose.forward = glm::vec3(0.0f);
+  EXPECT_MSG_HAS(error_of([&] { validate(s); }), "camera forward must be a finite non-zero vector");
+  s.pose.forward = glm::vec3(0.0f, 2.0f, 0.0f);
+  EXPECT_MSG_HAS(error_of([&] { validate(s); }), "must not be parallel to forward");
+  ShadowMapParams m;
+  m.world_to_light_clip[1][1] = 0.0f;
+  EXPECT_MSG_HAS(error_of([&] { validate(m); }), "singular");
+  m.world_to_light_clip[1][1] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_MSG_HAS(error_of([&] { validate(m); }), "row 1, column 1) is not finite");
+  VolumeSettings settings;
+  settings.steps = 0;
+  EXPECT_MSG_HAS(error_of([&] { validate(settings); }), "volume steps must be in [1, 4096] (got 0)");
+  settings.steps = 50;
+  settings.resolution_divisor = 3;
+  EXPECT_MSG_HAS(error_of([&] { validate(settings); }), "resolution divisor must be 1 (full), 2 (half) or 4");
+}
+
+}  // namespace
+}  // namespace fogcl::test
