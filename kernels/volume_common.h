@@ -69,7 +69,7 @@
 #define VOL_F_SHADOW_BIAS 59
 #define VOL_F_COUNT 64
 
-/* One volume's parameters (docs/volumetric.md §Volume), resolved defaults included. */
+/* One volume's parameters (docs/volumetric.md §A volume), resolved defaults included. */
 #define VOL_V_CENTER 0       /* (3) */
 #define VOL_V_RADIUS 3
 #define VOL_V_DENSITY 4

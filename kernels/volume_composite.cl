@@ -1,5 +1,5 @@
 /* volume_composite.cl — the target upsampled onto the frame and composited over it
- * (docs/volumetric.md §Resolution and composite). One work-item per frame pixel.
+ * (docs/volumetric.md §Resolution, upsampling, composite). One work-item per frame pixel.
  *
  * Variant switches (the host's volume_composite_options()):
  *   VOL_SCALE        resolution divisor s: 1, 2 or 4

@@ -1,4 +1,4 @@
-/* volume_integrate.h — the two integrators of the march (docs/volumetric.md §March) and the
+/* volume_integrate.h — the two integrators of the march (docs/volumetric.md §The march) and the
  * per-pixel entry both the kernel and the C++ paths run. Needs volume_common.h, volume_ray.h and
  * volume_noise.h.
  *

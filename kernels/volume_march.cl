@@ -1,5 +1,5 @@
 /* volume_march.cl — the march of the fog volumes into the reduced-resolution target
- * (docs/volumetric.md §March). One work-item per target pixel; global size (ceil(W / s),
+ * (docs/volumetric.md §The march). One work-item per target pixel; global size (ceil(W / s),
  * ceil(H / s)). The maths is in the shared headers, which the C++ paths compile too.
  *
  * Variant switches (the host's volume_march_options(); none is optional):

@@ -1,4 +1,4 @@
-/* volume_noise.h — what shapes a volume's density (docs/volumetric.md §Volume): the per-ray
+/* volume_noise.h — what shapes a volume's density (docs/volumetric.md §A volume): the per-ray
  * jitter hash, the noise texture's trilinear sample, the seed's shape + detail density field and
  * its fades. Needs volume_common.h. */
 
@@ -74,7 +74,7 @@ VOL_FN VOL_REAL vol_pow(VOL_REAL x, VOL_REAL e) { return e == (VOL_REAL)1 ? x : 
  * cut-off, then eroded by detail noise (R, B, A weighted 0.6 / 0.25 / 0.15; G is unused, as in
  * the seed). The cut-off remaps [cutoff, 1] to [0, 1]: the seed divides by (1 - fog) instead,
  * which saturates all noise above (1 + cutoff) / 2 and is singular at fog = 1 (a departure,
- * docs/volumetric.md §Departures). */
+ * docs/volumetric.md §Departures from the seed). */
 VOL_FN VOL_REAL vol_density_field(VOL_GLOBAL const float* vol, VOL_V3 p, VOL_REAL time, VOL_NOISE_PARAM,
                                   int noise_size, int detail) {
   const VOL_V3 speed = VOL_P3(vol, VOL_V_SPEED);

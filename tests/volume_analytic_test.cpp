@@ -1,4 +1,4 @@
-// The physical integrator against closed forms (docs/volumetric.md §March): a sphere of constant
+// The physical integrator against closed forms (docs/volumetric.md §The march): a sphere of constant
 // extinction, noise and fades off, lit by ambient light only, has T = e^(-sigma_t L) over the
 // chord L the depth buffer leaves of it, and in-scattered I = albedo * ambient * (1 - T), for any
 // step count. Checked on the scalar<double> path and on the OpenCL kernel, camera outside, inside,

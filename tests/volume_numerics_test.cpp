@@ -1,5 +1,5 @@
 // The march on stiff and thin media, the jitter's convergence and the depth-aware upsampling
-// (docs/volumetric.md §March, §Resolution and composite).
+// (docs/volumetric.md §The march, §Resolution, upsampling, composite).
 #include <algorithm>
 #include <array>
 #include <cmath>

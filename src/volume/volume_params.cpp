@@ -141,7 +141,7 @@ const char* to_string(VolumeUpsampling u) { return u == VolumeUpsampling::depth_
 const char* to_string(NoiseSampling s) { return s == NoiseSampling::buffer ? "buffer" : "image"; }
 
 namespace {
-// The camera's rotation, view -> world (docs/volumetric.md §World): columns right, up', forward.
+// The camera's rotation, view -> world (docs/volumetric.md §World and rays): columns right, up', forward.
 struct Basis {
   glm::vec3 right, up, forward;
 };
@@ -158,7 +158,7 @@ bool volume_visible(const FogVolume& v, const Basis& b, const CameraPose& pose, 
   const glm::dvec3 d = glm::dvec3(v.center) - glm::dvec3(pose.eye);
   const glm::dvec3 c(glm::dot(d, glm::dvec3(b.right)), glm::dot(d, glm::dvec3(b.up)), glm::dot(d, glm::dvec3(b.forward)));
   const double r = v.radius, n = cam.near_plane();
-  // No far-plane test: sky pixels see infinitely far (t_scene = +inf, docs/volumetric.md §World),
+  // No far-plane test: sky pixels see infinitely far (t_scene = +inf, docs/volumetric.md §World and rays),
   // so a volume beyond the far plane still shows against the sky; the depth range hides it
   // wherever no pixel is sky.
   if (c.z + r < n) return false;

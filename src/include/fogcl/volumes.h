@@ -29,7 +29,7 @@ struct FogVolume {
   float max_y = 100.0f;                 // height fade: fog thins out towards this world y
   float fade_y = 2.0f;                  // height fade width [world], >= 0 (0: no height fade)
   float fade_edge = 20.0f;              // edge fade width in from the sphere's surface [world], >= 0
-  float proximity_fade = 10.0f;         // fade width in front of an occluder [world], >= 0
+  float proximity_fade = 10.0f;         // fog thins out within this distance of the camera [world], >= 0
   float fog_exponent = 1.0f;            // shape noise exponent, > 0
   float fog_cutoff = 0.0f;              // noise below this is no fog, in [0, 1)
   float detail_exponent = 1.0f;         // detail noise exponent, > 0
@@ -53,7 +53,7 @@ struct FogVolume {
   std::optional<glm::vec3> ambient;     // ambient radiance RGB >= 0; default 0.1 * light color
 };
 
-// Where the camera is (docs/volumetric.md §World): Unity's world space, left-handed, +y up.
+// Where the camera is (docs/volumetric.md §World and rays): Unity's world space, left-handed, +y up.
 struct CameraPose {
   glm::vec3 eye{0.0f};                  // [world], finite
   glm::vec3 forward{0.0f, 0.0f, 1.0f};  // view direction, non-zero (normalised by fogcl)
@@ -97,7 +97,7 @@ enum class NoiseSampling {
   image,   // an OpenCL 3D image with the sampler's linear filtering (hardware on GPUs)
 };
 
-// Quality choices of the pass; each is a kernel build option (docs/volumetric.md §Variants).
+// Quality choices of the pass; each is a kernel build option (docs/volumetric.md §Variants and culling).
 struct VolumeSettings {
   VolumeIntegrator integrator = VolumeIntegrator::stylized;
   int steps = 50;                        // march steps per ray, in [1, 4096]; the seed's 50
