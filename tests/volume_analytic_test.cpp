@@ -158,7 +158,9 @@ TEST_P(VolumeAnalytic, PhysicalMatchesClosedForm) {
   EXPECT_LE(worst_t, 1e-5);
   // The float kernel: its rays and chords are float geometry, and a ray grazing the sphere turns
   // an ulp of the perpendicular distance into ~1e-5 of the chord.
-  if (device) EXPECT_LE(worst_kernel, 1e-4);
+  if (device) {
+    EXPECT_LE(worst_kernel, 1e-4);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, VolumeAnalytic,

@@ -61,8 +61,9 @@ TEST(VolumeStiffness, EnergyConservedFromClearAirToOpaque) {
       EXPECT_LE(ef, 1e-6) << "float, sigma_t*d " << x << ", " << steps << " steps";
       EXPECT_LE(ed, 1e-12) << "double, sigma_t*d " << x << ", " << steps << " steps";
       // Thin media keep their digits: A = 1 - e^(-sigma_t L) to a few ulps of itself.
-      if (x > 0 && x * steps < 1e-3)
+      if (x > 0 && x * steps < 1e-3) {
         EXPECT_NEAR(double(f[1]), -std::expm1(-sigma), 1e-6 * -std::expm1(-sigma)) << "thin, sigma_t*d " << x;
+      }
       const double naive = riemann(sigma, steps) - (1.0 - std::exp(-sigma));
       std::printf("  %10.0e %14.3g %14.3g %14.3g %14.3g\n", x, double(f[0]) + tf - 1.0, d[0] + td - 1.0, tf, naive);
       ++checked;

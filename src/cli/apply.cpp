@@ -107,7 +107,9 @@ FogSettings pass_settings(const ApplyOptions& o, Backend& backend, ColorFormat s
   return s;
 }
 
-void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backend, bool print_setup) {
+// volumes: null without --volumes; sequence_frame: the frame number, -1 for a single file.
+void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backend, bool print_setup,
+                 VolumeStage* volumes, int sequence_frame) {
   const DepthKind kind = parse_depth_kind(o.depth_kind);
   // Outside the depth's data window (and in empty deep pixels) there is nothing: background.
   // Raw depth gets the sky value; eye / distance depth gets +inf, which converts to it.
@@ -170,7 +172,13 @@ void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backen
       std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
   }
   ColorImage out;
-  backend.apply(color.color, depth, out, params, settings);
+  const ColorImage* fog_in = &color.color;
+  ColorImage with_volumes;
+  if (volumes != nullptr) {  // DESIGN §5: the volumes first, the deferred fog on their result
+    volumes->apply(color.color, depth, with_volumes, params, sequence_frame, print_setup);
+    fog_in = &with_volumes;
+  }
+  backend.apply(*fog_in, depth, out, params, settings);
   write_exr_output(paths.out, out, color, o.rgba_only);
   if (!paths.png.empty()) write_png_preview(paths.png, out);
 }
@@ -195,7 +203,8 @@ int run_apply(const ApplyOptions& o) {
         throw Error("'" + p->text + "' has a frame placeholder but --color '" + o.color_path + "' has none");
     if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
     Backend backend(o.device);
-    apply_frame(o, {o.color_path, o.depth_path, o.out_path, o.png_path}, backend, o.verbose);
+    const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
+    apply_frame(o, {o.color_path, o.depth_path, o.out_path, o.png_path}, backend, o.verbose, volumes.get(), -1);
     return 0;
   }
 
@@ -207,6 +216,7 @@ int run_apply(const ApplyOptions& o) {
   if (frames.empty()) throw Error("'" + o.color_path + "': no frames found (give --frames FIRST-LAST)");
 
   Backend backend(o.device);  // one device, one context, one program cache for every frame
+  const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
   ProgressBar progress(int(frames.size()), true);
   std::vector<std::string> failures;
   int done = 0;
@@ -214,7 +224,7 @@ int run_apply(const ApplyOptions& o) {
     const FramePaths paths{frame_path(color, frame), o.depth_path.empty() ? "" : frame_path(depth, frame),
                            frame_path(out, frame), o.png_path.empty() ? "" : frame_path(png, frame)};
     try {
-      apply_frame(o, paths, backend, o.verbose && done == 0 && failures.empty());
+      apply_frame(o, paths, backend, o.verbose && done == 0 && failures.empty(), volumes.get(), frame);
     } catch (const std::exception& e) {
       progress.clear();
       if (!o.keep_going) throw Error("frame " + std::to_string(frame) + ": " + e.what());

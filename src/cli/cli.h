@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "cli/volumes_cli.h"
 #include "fogcl/fogcl.h"
 
 namespace fogcl::cli {
@@ -54,6 +55,7 @@ struct ApplyOptions {
   FogSettings settings;
   std::string device;
   bool verbose = false;
+  VolumeCliOptions volumes;        // --volumes and its flags (cli/volumes_cli.h)
 };
 int run_apply(const ApplyOptions& options);
 

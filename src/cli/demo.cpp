@@ -103,6 +103,8 @@ int run_demo(const DemoOptions& o) {
       write_png_preview(path(stem + ".png"), out);
     }
   }
+  for (const DemoSetting& d : demo_settings())  // the volumetric rows; one adds this deferred fog
+    if (std::string(d.name) == "exp2-distance") run_demo_volumes(o, backends, d.settings);
   std::printf("\nwrote EXR and PNG images to %s/\n", o.out_dir.c_str());
   return 0;
 }

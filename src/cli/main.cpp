@@ -80,8 +80,7 @@ int main(int argc, char** argv) {
   apply_cmd->add_option("--aspect", ap.aspect,
                         "Width / height (default: the file's camera, else the image's display window)");
   apply_cmd->add_flag("--reversed-z", ap.reversed_z, "Depth is reversed Z (1 at near, 0 at far)");
-  apply_cmd->add_option("--mode", mode, "Fog mode")
-      ->required()
+  apply_cmd->add_option("--mode", mode, "Fog mode (required, except with --volumes: then off by default)")
       ->transform(CLI::IsMember(kModes, CLI::ignore_case));
   apply_cmd->add_option("--start", ap.settings.start, "Linear fog start [world units]")->capture_default_str();
   apply_cmd->add_option("--end", ap.settings.end, "Linear fog end [world units], >= start")->capture_default_str();
@@ -99,6 +98,7 @@ int main(int argc, char** argv) {
                         "$XDG_CACHE_HOME/fogcl) is <= E; not with --precision");
   apply_cmd->add_option("--device", ap.device, kDeviceHelp);
   apply_cmd->add_flag("--verbose", ap.verbose, "Print the device, the kernel variant chosen and why");
+  fogcl::cli::add_volume_options(*apply_cmd, ap.volumes);
 
   fogcl::cli::ReportCliOptions report;
   CLI::App* report_cmd = app.add_subcommand(
@@ -122,6 +122,12 @@ int main(int argc, char** argv) {
   try {
     if (*demo_cmd) return fogcl::cli::run_demo(demo);
     if (*report_cmd) return fogcl::cli::run_report(report);
+    fogcl::cli::note_given_volume_flags(*apply_cmd, ap.volumes);
+    // With volumes the deferred fog is optional: no --mode runs only the volumetric pass.
+    if (apply_cmd->count("--mode") == 0) {
+      if (ap.volumes.volumes_path.empty()) throw fogcl::Error("--mode is required (off, linear, exp or exp2)");
+      mode = "off";
+    }
     ap.precision_given = apply_cmd->count("--precision") > 0;
     ap.max_error_given = apply_cmd->count("--max-error") > 0;
     if (apply_cmd->count("--far") == 0 && !ap.infinite_far)

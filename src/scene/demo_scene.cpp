@@ -83,6 +83,9 @@ bool in_shadow(V3 p, V3 to_light) {
   return false;
 }
 
+// The light, as the shading below and the shadow map use it.
+const V3 kToLight{0.35, 0.80, -0.50};
+
 V3 sky(V3 dir_unit) {
   const double s = std::sqrt(std::clamp(dir_unit.y, 0.0, 1.0));
   return kSkyHorizon * (1.0 - s) + kSkyZenith * s;
@@ -136,7 +139,7 @@ DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera,
   }
   if (!eye_outside) throw Error("demo view eye must lie outside the scene's spheres");
 
-  const V3 to_light = normalize(V3{0.35, 0.80, -0.50});
+  const V3 to_light = normalize(kToLight);
 
   float* const rgba32 = format == ColorFormat::rgba32f ? frame.color.rgba32f() : nullptr;
   for (int y = 0; y < height; ++y) {
@@ -215,6 +218,66 @@ DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera,
     }
   }
   return frame;
+}
+
+MainLight demo_light() {
+  MainLight light;
+  const V3 d = normalize(kToLight);
+  light.direction = glm::vec3(float(d.x), float(d.y), float(d.z));
+  light.color = glm::vec3(float(kSunColor.x), float(kSunColor.y), float(kSunColor.z));
+  return light;
+}
+
+ShadowMap render_demo_shadow_map(int width, int height, const DemoShadowRegion& region) {
+  if (width < 1 || height < 1)
+    throw Error("demo shadow map size must be at least 1x1 (got " + std::to_string(width) + "x" +
+                std::to_string(height) + ")");
+  // Light camera basis (left-handed, as a camera's): forward along the light's rays, right =
+  // normalize(cross(+y, forward)), up = cross(forward, right). The light is never vertical here.
+  const V3 forward = normalize(kToLight) * -1.0;
+  const V3 right = normalize(cross(V3{0.0, 1.0, 0.0}, forward));
+  const V3 up = cross(forward, right);
+
+  // Fit the orthographic box to the region's corners in light view space.
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (int c = 0; c < 8; ++c) {
+    const V3 p{(c & 1) ? region.max.x : region.min.x, (c & 2) ? region.max.y : region.min.y,
+               (c & 4) ? region.max.z : region.min.z};
+    const double l[3] = {dot(p, right), dot(p, up), dot(p, forward)};
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], l[k]), hi[k] = std::max(hi[k], l[k]);
+  }
+  for (int k = 0; k < 3; ++k) lo[k] -= 1.0, hi[k] += 1.0;  // the map's edges keep clear of the region
+  const double sx = hi[0] - lo[0], sy = hi[1] - lo[1], sz = hi[2] - lo[2];
+  if (!(sx > 0.0 && sy > 0.0 && sz > 0.0)) throw Error("demo shadow region must have a non-empty extent");
+
+  // world -> light clip, row by row: clip.x = (2 l.x - (hi + lo)) / sx, clip.y likewise,
+  // clip.z = (l.z - near) / sz, clip.w = 1.
+  const double rows[4][4] = {
+      {2.0 * right.x / sx, 2.0 * right.y / sx, 2.0 * right.z / sx, -(hi[0] + lo[0]) / sx},
+      {2.0 * up.x / sy, 2.0 * up.y / sy, 2.0 * up.z / sy, -(hi[1] + lo[1]) / sy},
+      {forward.x / sz, forward.y / sz, forward.z / sz, -lo[2] / sz},
+      {0.0, 0.0, 0.0, 1.0}};
+  ShadowMap map;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) map.params.world_to_light_clip[c][r] = float(rows[r][c]);  // GLM: [column][row]
+  map.params.reversed_z = false;
+
+  map.depth = DepthImage(width, height, 1.0f);
+  for (int y = 0; y < height; ++y) {
+    const double v = 1.0 - (double(y) + 0.5) / double(height);  // row 0 is the top: v = 1
+    for (int x = 0; x < width; ++x) {
+      const double u = (double(x) + 0.5) / double(width);
+      // The texel's ray starts on the light's near plane and runs along forward (unit length,
+      // so t is the distance past the near plane).
+      const V3 o = right * (lo[0] + u * sx) + up * (lo[1] + v * sy) + forward * lo[2];
+      double t = std::numeric_limits<double>::infinity();
+      for (const Sphere& s : kSpheres) t = std::min(t, hit_sphere(s, o, forward, 0.0));
+      // The ground (forward.y < 0); an origin below it sees only ground: depth 0.
+      t = std::min(t, std::max(-o.y / forward.y, 0.0));
+      if (t <= sz) map.depth.at(x, y) = float(t / sz);
+    }
+  }
+  return map;
 }
 
 }  // namespace fogcl

@@ -24,6 +24,7 @@
 
 #include "fogcl/camera.h"
 #include "fogcl/image.h"
+#include "fogcl/volumes.h"
 
 namespace fogcl {
 
@@ -46,5 +47,25 @@ struct DemoView {
 // float(width) / float(height); the camera is validated as make_camera_params does.
 DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera = {},
                             const DemoView& view = {}, ColorFormat format = ColorFormat::rgba32f);
+
+// The scene's directional light as the volumetric pass takes it: direction normalize(0.35, 0.8,
+// -0.5) (toward the light), color (1, 0.96, 0.9).
+MainLight demo_light();
+
+// The world region demo_shadow_map() covers: every sphere, the ground and the air up to y = 12
+// around the default view (x in [-25, 45], z in [-15, 65]).
+struct DemoShadowRegion {
+  glm::vec3 min{-25.0f, 0.0f, -15.0f};
+  glm::vec3 max{45.0f, 12.0f, 65.0f};
+};
+
+// The scene's depth as its directional light sees it: an orthographic light camera looking along
+// -demo_light().direction, fitted to `region` (its 8 corners lie inside the view volume, with 1
+// world unit to spare on every side), the same spheres and ground ray cast in double, one ray per texel
+// centre. Depth is float32 conventional Z in [0, 1] (0 at the light's near plane, linear in
+// distance along the light); a texel whose ray meets nothing before the far plane holds 1. The
+// params' world_to_light_clip follows ShadowMapParams: clip xy in [-1, 1] -> the map's uv (v = 0
+// at the bottom row), clip z / w (w = 1) the stored depth. width, height >= 1.
+ShadowMap render_demo_shadow_map(int width = 1024, int height = 1024, const DemoShadowRegion& region = {});
 
 }  // namespace fogcl

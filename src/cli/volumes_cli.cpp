@@ -1,0 +1,558 @@
+#include "cli/volumes_cli.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "fogcl/exr_io.h"
+#include "fogcl/volume_scalar.h"
+
+namespace fogcl::cli {
+
+namespace {
+
+using nlohmann::json;
+
+std::string str(double v) {
+  std::ostringstream s;
+  s.precision(9);
+  s << v;
+  return s.str();
+}
+
+// ---- VOLUMES.json ----------------------------------------------------------------------------
+
+using Member = std::variant<float FogVolume::*, glm::vec3 FogVolume::*, glm::vec4 FogVolume::*, bool FogVolume::*,
+                            std::optional<glm::vec3> FogVolume::*>;
+
+// Every FogVolume field by its snake_case name (fogcl/volumes.h documents units and ranges).
+const std::map<std::string, Member>& volume_fields() {
+  static const std::map<std::string, Member> fields{
+      {"center", &FogVolume::center},
+      {"radius", &FogVolume::radius},
+      {"density", &FogVolume::density},
+      {"max_y", &FogVolume::max_y},
+      {"fade_y", &FogVolume::fade_y},
+      {"fade_edge", &FogVolume::fade_edge},
+      {"proximity_fade", &FogVolume::proximity_fade},
+      {"fog_exponent", &FogVolume::fog_exponent},
+      {"fog_cutoff", &FogVolume::fog_cutoff},
+      {"detail_exponent", &FogVolume::detail_exponent},
+      {"detail_strength", &FogVolume::detail_strength},
+      {"fog_color", &FogVolume::fog_color},
+      {"directional_fog_color", &FogVolume::directional_fog_color},
+      {"directional_falloff", &FogVolume::directional_falloff},
+      {"light_contribution", &FogVolume::light_contribution},
+      {"directional_light_contribution", &FogVolume::directional_light_contribution},
+      {"shadow_strength", &FogVolume::shadow_strength},
+      {"shadow_reverse_strength", &FogVolume::shadow_reverse_strength},
+      {"tiling", &FogVolume::tiling},
+      {"speed", &FogVolume::speed},
+      {"detail_tiling", &FogVolume::detail_tiling},
+      {"detail_speed_modifier", &FogVolume::detail_speed_modifier},
+      {"occluder_overshoot", &FogVolume::occluder_overshoot},
+      {"noise", &FogVolume::noise},
+      {"albedo", &FogVolume::albedo},
+      {"anisotropy", &FogVolume::anisotropy},
+      {"ambient", &FogVolume::ambient},
+  };
+  return fields;
+}
+
+// Levenshtein distance, for "did you mean" on an unknown key.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// A JSON value in a message: numbers as numbers, the rest as JSON text, cut to stay one short line.
+std::string shown(const json& j) {
+  std::string s = j.is_number() ? str(j.get<double>()) : j.dump();
+  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  return s;
+}
+
+// Reads the keys of one volume; every failure names the file, the volume, the key and the rule.
+struct KeyReader {
+  std::string where;  // "FILE: volume I: "
+
+  [[noreturn]] void fail(const std::string& key, const std::string& rule, const std::string& got) const {
+    throw Error(where + "'" + key + "' " + rule + " (got " + got + ")");
+  }
+  // A float: a JSON number, finite in float (JSON has no NaN or Inf; 1e39 would become inf).
+  float real(const std::string& key, const json& j) const {
+    if (!j.is_number()) fail(key, "must be a number", shown(j));
+    const double v = j.get<double>();
+    if (!(std::isfinite(v) && std::fabs(v) <= double(FLT_MAX)))
+      fail(key, "must be a finite number within float range (|x| <= 3.4e38)", shown(j));
+    return float(v);
+  }
+  // An array of n numbers, or of any count in [lo, hi] for colors.
+  std::vector<float> reals(const std::string& key, const json& j, std::size_t lo, std::size_t hi,
+                           const char* rule) const {
+    if (!j.is_array() || j.size() < lo || j.size() > hi) fail(key, rule, shown(j));
+    std::vector<float> out;
+    for (std::size_t k = 0; k < j.size(); ++k) out.push_back(real(key + "[" + std::to_string(k) + "]", j[k]));
+    return out;
+  }
+  glm::vec3 vec3(const std::string& key, const json& j) const {
+    const std::vector<float> v = reals(key, j, 3, 3, "must be an array of 3 numbers [x, y, z]");
+    return glm::vec3(v[0], v[1], v[2]);
+  }
+  // Colors: RGBA, or RGB with alpha 1.
+  glm::vec4 color(const std::string& key, const json& j) const {
+    const std::vector<float> v = reals(key, j, 3, 4, "must be an array of 3 or 4 numbers [r, g, b(, a)]");
+    return glm::vec4(v[0], v[1], v[2], v.size() == 4 ? v[3] : 1.0f);
+  }
+  bool boolean(const std::string& key, const json& j) const {
+    if (!j.is_boolean()) fail(key, "must be true or false", shown(j));
+    return j.get<bool>();
+  }
+};
+
+FogVolume parse_volume(const json& j, const KeyReader& r) {
+  if (!j.is_object()) throw Error(r.where + "must be an object {\"center\": [x, y, z], \"radius\": r, ...} (got " + shown(j) + ")");
+  if (!j.contains("center")) throw Error(r.where + "'center' is missing (every volume needs \"center\": [x, y, z])");
+  if (!j.contains("radius")) throw Error(r.where + "'radius' is missing (every volume needs \"radius\": r > 0)");
+  FogVolume v;
+  for (const auto& [key, value] : j.items()) {
+    const auto field = volume_fields().find(key);
+    if (field == volume_fields().end()) {
+      std::string best;
+      std::size_t best_d = 4;  // suggest only close names
+      for (const auto& f : volume_fields()) {
+        const std::size_t d = edit_distance(key, f.first);
+        if (d < best_d) best = f.first, best_d = d;
+      }
+      throw Error(r.where + "unknown key '" + key + "' (" + (best.empty() ? "" : "did you mean '" + best + "'? ") +
+                  "the keys are FogVolume's fields in snake_case, README 'VOLUMES.json')");
+    }
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_reference_t<decltype(v.*member)>;
+          if constexpr (std::is_same_v<T, float>) v.*member = r.real(key, value);
+          if constexpr (std::is_same_v<T, glm::vec3>) v.*member = r.vec3(key, value);
+          if constexpr (std::is_same_v<T, glm::vec4>) v.*member = r.color(key, value);
+          if constexpr (std::is_same_v<T, bool>) v.*member = r.boolean(key, value);
+          if constexpr (std::is_same_v<T, std::optional<glm::vec3>>) v.*member = r.vec3(key, value);
+        },
+        field->second);
+  }
+  // The sign rules the issue names first, in the file's words; then every range of the library.
+  if (!(v.radius > 0.0f)) r.fail("radius", "must be > 0", shown(j["radius"]));
+  if (v.density < 0.0f) r.fail("density", "must be >= 0", shown(j["density"]));
+  return v;
+}
+
+// The path of what the parser was reading when it failed, from the callback's key events.
+struct ParseContext {
+  std::string top_key;     // last key of the top-level object
+  std::string volume_key;  // last key of the current volume object
+  int volume = -1;         // index of the current volume object
+  std::vector<std::set<std::string>> keys;  // keys seen in each open object (duplicates)
+  std::string duplicate;   // "volume 1: duplicate key 'radius'"
+
+  std::string where() const {
+    if (top_key == "volumes" && volume >= 0)
+      return "volume " + std::to_string(volume) + (volume_key.empty() ? "" : ": '" + volume_key + "'");
+    return top_key.empty() ? "top level" : "top level: '" + top_key + "'";
+  }
+};
+
+}  // namespace
+
+std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name) {
+  ParseContext ctx;
+  // Depths as nlohmann counts them: the top object 0, its keys 1, volume objects 2, their keys 3.
+  const json::parser_callback_t track = [&ctx](int depth, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+        ctx.keys.emplace_back();
+        if (depth == 2 && ctx.top_key == "volumes") ++ctx.volume, ctx.volume_key.clear();
+        break;
+      case json::parse_event_t::object_end:
+        if (!ctx.keys.empty()) ctx.keys.pop_back();
+        break;
+      case json::parse_event_t::key: {
+        const std::string key = parsed.get<std::string>();
+        if (depth == 1) ctx.top_key = key;
+        if (depth == 3) ctx.volume_key = key;
+        // nlohmann keeps the last of repeated keys; a repeat is almost always a mistake.
+        if (!ctx.keys.empty() && !ctx.keys.back().insert(key).second && ctx.duplicate.empty())
+          ctx.duplicate = (depth == 3 ? "volume " + std::to_string(ctx.volume) + ": " : std::string()) +
+                          "duplicate key '" + key + "' (each key may appear once)";
+        break;
+      }
+      default:
+        break;
+    }
+    return true;
+  };
+  json doc;
+  try {
+    doc = json::parse(text, track);
+  } catch (const json::parse_error& e) {
+    // "[json.exception.parse_error.101] parse error at line 2, column 12: ..." without the tag.
+    std::string what = e.what();
+    const std::size_t tag = what.find("] ");
+    if (tag != std::string::npos) what = what.substr(tag + 2);
+    throw Error(name + ": malformed JSON: " + what);
+  } catch (const json::exception& e) {
+    // 1e999 and the like: nlohmann refuses numbers that overflow a double (406), without a position.
+    std::string what = e.what();
+    const std::size_t tag = what.find("] ");
+    if (tag != std::string::npos) what = what.substr(tag + 2);
+    throw Error(name + ": " + ctx.where() + " must be a finite number (" + what + ")");
+  }
+  if (!ctx.duplicate.empty()) throw Error(name + ": " + ctx.duplicate);
+  if (!doc.is_object()) throw Error(name + ": the top level must be an object {\"volumes\": [...]} (got " + shown(doc) + ")");
+  for (const auto& [key, value] : doc.items())
+    if (key != "volumes") throw Error(name + ": top level: unknown key '" + key + "' (the only key is \"volumes\")");
+  if (!doc.contains("volumes")) throw Error(name + ": top level: 'volumes' is missing (expected {\"volumes\": [...]})");
+  const json& list = doc["volumes"];
+  if (!list.is_array()) throw Error(name + ": top level: 'volumes' must be an array of volume objects (got " + shown(list) + ")");
+  std::vector<FogVolume> volumes;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    volumes.push_back(parse_volume(list[i], KeyReader{name + ": volume " + std::to_string(i) + ": "}));
+    try {
+      validate(volumes.back(), i);  // "volume I: KEY RULE (got V)"
+    } catch (const Error& e) {
+      throw Error(name + ": " + e.what());
+    }
+  }
+  return volumes;
+}
+
+std::vector<FogVolume> read_volumes_json(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open the volumes file (--volumes)");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error(path + ": read error (--volumes)");
+  return parse_volumes_json(text.str(), path);
+}
+
+namespace {
+// The shortest decimal that reads back as f ("0.45", not the double 0.44999998807907104).
+double shortest(float f) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, f);
+  return std::strtod(std::string(buf, r.ptr).c_str(), nullptr);
+}
+}  // namespace
+
+std::string volumes_to_json(const std::vector<FogVolume>& volumes) {
+  json list = json::array();
+  for (const FogVolume& v : volumes) {
+    json j = json::object();
+    for (const auto& [key, member] : volume_fields())
+      std::visit(
+          [&, key = key](auto m) {
+            using T = std::remove_cv_t<std::remove_reference_t<decltype(v.*m)>>;
+            const auto v3 = [](const glm::vec3& a) { return json::array({shortest(a.x), shortest(a.y), shortest(a.z)}); };
+            if constexpr (std::is_same_v<T, float>) j[key] = shortest(v.*m);
+            if constexpr (std::is_same_v<T, bool>) j[key] = v.*m;
+            if constexpr (std::is_same_v<T, glm::vec3>) j[key] = v3(v.*m);
+            if constexpr (std::is_same_v<T, glm::vec4>)
+              j[key] = json::array({shortest((v.*m).r), shortest((v.*m).g), shortest((v.*m).b), shortest((v.*m).a)});
+            if constexpr (std::is_same_v<T, std::optional<glm::vec3>>)
+              if (v.*m) j[key] = v3(*(v.*m));
+          },
+          member);
+    list.push_back(j);
+  }
+  return json{{"volumes", list}}.dump(2) + "\n";
+}
+
+namespace {
+
+// "X,Y,Z" -> three finite floats, or an error naming the flag.
+glm::vec3 parse_vec3(const std::string& flag, const std::string& text) {
+  std::vector<float> v;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    const double d = std::strtod(part.c_str(), &end);
+    if (part.empty() || end == part.c_str() || *end != '\0')
+      throw Error(flag + " must be three comma-separated numbers X,Y,Z (got '" + text + "')");
+    v.push_back(float(d));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (v.size() != 3) throw Error(flag + " must be three comma-separated numbers X,Y,Z (got '" + text + "')");
+  for (float x : v)
+    if (!std::isfinite(x)) throw Error(flag + " must be finite (got '" + text + "')");
+  return glm::vec3(v[0], v[1], v[2]);
+}
+
+const std::map<std::string, VolumeIntegrator> kIntegrators{{"stylized", VolumeIntegrator::stylized},
+                                                            {"physical", VolumeIntegrator::physical}};
+const std::map<std::string, int> kResolutions{{"full", 1}, {"half", 2}, {"quarter", 4}};
+const std::map<std::string, VolumeUpsampling> kUpsamplings{{"depth-aware", VolumeUpsampling::depth_aware},
+                                                           {"bilinear", VolumeUpsampling::bilinear}};
+const std::map<std::string, NoiseSampling> kSamplings{{"buffer", NoiseSampling::buffer}, {"image", NoiseSampling::image}};
+
+// The flags that mean nothing without --volumes.
+const char* const kVolumeFlags[] = {"--eye", "--forward", "--up", "--light-dir", "--light-color", "--time", "--frame",
+                                    "--fps", "--integrator", "--steps", "--volume-resolution", "--upsample",
+                                    "--noise-size", "--noise-seed", "--noise-sampling", "--shadow-map",
+                                    "--light-view-proj", "--shadow-reversed-z"};
+
+bool given(const VolumeCliOptions& o, const std::string& flag) {
+  return std::find(o.given.begin(), o.given.end(), flag) != o.given.end();
+}
+
+const char* resolution_name(int divisor) { return divisor == 1 ? "full" : divisor == 2 ? "half" : "quarter"; }
+
+}  // namespace
+
+void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
+  const char* group = "Volumetric fog volumes (DESIGN.md §5; run before the deferred fog)";
+  app.add_option("--volumes", o.volumes_path,
+                 "VOLUMES.json: {\"volumes\": [{\"center\": [x,y,z], \"radius\": r, ...}]} (README 'VOLUMES.json'); "
+                 "--mode may then be left out (off: only the volumes)")
+      ->group(group);
+  app.add_option("--eye", o.eye, "Camera position X,Y,Z [world units] (required with --volumes)")->group(group);
+  app.add_option("--forward", o.forward, "Camera view direction X,Y,Z, non-zero (required with --volumes)")->group(group);
+  app.add_option("--up", o.up, "Camera up X,Y,Z, not parallel to --forward (required with --volumes)")->group(group);
+  app.add_option("--light-dir", o.light_dir, "Main light direction X,Y,Z, from the scene toward the light")
+      ->capture_default_str()
+      ->group(group);
+  app.add_option("--light-color", o.light_color, "Main light color, linear R,G,B >= 0")->capture_default_str()->group(group);
+  app.add_option("--time", o.time,
+                 "Noise scroll time [s] (default 0; sequences: frame number / --fps)")
+      ->group(group);
+  app.add_option("--frame", o.frame, "Jitter frame index >= 0 (default 0; sequences: the frame number)")->group(group);
+  app.add_option("--fps", o.fps, "Sequences: frames per second for the default --time, > 0")->capture_default_str()->group(group);
+  app.add_option("--integrator", o.integrator, "stylized (the seed's look) or physical (energy-conserving)")
+      ->transform(CLI::IsMember(kIntegrators, CLI::ignore_case))
+      ->capture_default_str()
+      ->group(group);
+  app.add_option("--steps", o.steps, "March steps per ray, in [1, 4096]")->capture_default_str()->group(group);
+  app.add_option("--volume-resolution", o.resolution, "March target: full, half or quarter resolution")
+      ->transform(CLI::IsMember(kResolutions, CLI::ignore_case))
+      ->capture_default_str()
+      ->group(group);
+  app.add_option("--upsample", o.upsample, "depth-aware (no fog bleeding across silhouettes) or bilinear")
+      ->transform(CLI::IsMember(kUpsamplings, CLI::ignore_case))
+      ->capture_default_str()
+      ->group(group);
+  app.add_option("--noise-size", o.noise_size, "Noise texels per side: 32, 64 or 128")->capture_default_str()->group(group);
+  app.add_option("--noise-seed", o.noise_seed, "Noise seed, in [0, 4294967295]")->capture_default_str()->group(group);
+  app.add_option("--noise-sampling", o.noise_sampling,
+                 "buffer (trilinear in the kernel) or image (OpenCL 3D image, hardware filtering on GPUs)")
+      ->transform(CLI::IsMember(kSamplings, CLI::ignore_case))
+      ->capture_default_str()
+      ->group(group);
+  app.add_option("--shadow-map", o.shadow_map_path,
+                 "Main light's shadow map: EXR with the light's raw depth in channel Z (or its only channel); "
+                 "needs --light-view-proj")
+      ->group(group);
+  app.add_option("--light-view-proj", o.light_view_proj,
+                 "World -> light clip matrix, 16 numbers m00,m01,...,m33 row-major (the first four are the first "
+                 "row); clip xy in [-1, 1] map to the shadow map's uv, clip z / w is its depth")
+      ->group(group);
+  app.add_flag("--shadow-reversed-z", o.shadow_reversed_z, "The shadow map holds reversed Z (1 at the light's near plane)")
+      ->group(group);
+}
+
+void note_given_volume_flags(const CLI::App& app, VolumeCliOptions& o) {
+  o.given.clear();
+  for (const char* flag : kVolumeFlags)
+    if (app.count(flag) > 0) o.given.push_back(flag);
+}
+
+glm::mat4 parse_light_view_proj(const std::string& text) {
+  std::vector<double> v;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    const double d = std::strtod(part.c_str(), &end);
+    if (part.empty() || end == part.c_str() || *end != '\0')
+      throw Error("--light-view-proj element " + std::to_string(v.size()) + " is not a number (got '" + part +
+                  "'; expected 16 comma-separated numbers, row-major)");
+    v.push_back(d);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  if (v.size() != 16)
+    throw Error("--light-view-proj must be 16 comma-separated numbers, row-major (got " + std::to_string(v.size()) + ")");
+  glm::mat4 m(1.0f);
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col) {
+      const double d = v[std::size_t(row * 4 + col)];
+      if (!(std::isfinite(d) && std::fabs(d) <= double(FLT_MAX)))
+        throw Error("--light-view-proj element (row " + std::to_string(row) + ", column " + std::to_string(col) +
+                    ") must be a finite float (got " + str(d) + ")");
+      m[col][row] = float(d);  // GLM: m[column][row]
+    }
+  return m;
+}
+
+ShadowMap read_shadow_map(const std::string& path, const glm::mat4& world_to_light_clip, bool reversed_z) {
+  ExrReadRequest request;
+  request.read_color = false;
+  request.depth_channel = "Z";
+  request.depth_single_channel_fallback = true;
+  // Outside the data window nothing was drawn: the light's far plane, which shadows nothing.
+  request.depth_outside = reversed_z ? 0.0f : 1.0f;
+  ShadowMap map;
+  try {
+    map.depth = std::move(read_exr(path, request).depth);
+  } catch (const Error& e) {
+    throw Error(std::string("--shadow-map: ") + e.what());
+  }
+  map.params.world_to_light_clip = world_to_light_clip;
+  map.params.reversed_z = reversed_z;
+  try {
+    validate(map.params);
+  } catch (const Error& e) {
+    throw Error(std::string("--light-view-proj: ") + e.what());
+  }
+  return map;
+}
+
+std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, const Runtime* runtime) {
+  if (o.volumes_path.empty()) {
+    if (!o.given.empty()) throw Error(o.given.front() + " needs --volumes (it sets up the volumetric pass)");
+    return nullptr;
+  }
+  for (const char* flag : {"--eye", "--forward", "--up"})
+    if (!given(o, flag)) throw Error(std::string(flag) + " is required with --volumes (the camera pose, X,Y,Z)");
+  auto stage = std::unique_ptr<VolumeStage>(new VolumeStage);
+  VolumeStage& s = *stage;
+  s.options_ = o;
+
+  // Camera pose and light, each checked with the flag's name before the library's own rules.
+  s.pose_.eye = parse_vec3("--eye", o.eye);
+  s.pose_.forward = parse_vec3("--forward", o.forward);
+  s.pose_.up = parse_vec3("--up", o.up);
+  if (s.pose_.forward == glm::vec3(0.0f)) throw Error("--forward must be a non-zero vector (got '" + o.forward + "')");
+  if (s.pose_.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + o.up + "')");
+  try {
+    validate(s.pose_);
+  } catch (const Error& e) {
+    throw Error(std::string("--forward/--up: ") + e.what());
+  }
+  s.light_.direction = parse_vec3("--light-dir", o.light_dir);
+  s.light_.color = parse_vec3("--light-color", o.light_color);
+  if (s.light_.direction == glm::vec3(0.0f)) throw Error("--light-dir must be a non-zero vector (got '" + o.light_dir + "')");
+  for (int k = 0; k < 3; ++k)
+    if (s.light_.color[k] < 0.0f) throw Error("--light-color must be >= 0 in each channel (got '" + o.light_color + "')");
+
+  if (!std::isfinite(o.time)) throw Error("--time must be finite (got " + str(o.time) + ")");
+  if (!(std::isfinite(o.fps) && o.fps > 0.0)) throw Error("--fps must be finite and > 0 (got " + str(o.fps) + ")");
+  if (o.frame < 0 || o.frame > 4294967295LL) throw Error("--frame must be in [0, 4294967295] (got " + std::to_string(o.frame) + ")");
+
+  VolumeSettings& st = s.settings_;
+  st.integrator = kIntegrators.at(o.integrator);
+  st.resolution_divisor = kResolutions.at(o.resolution);
+  st.upsampling = kUpsamplings.at(o.upsample);
+  st.noise_sampling = kSamplings.at(o.noise_sampling);
+  if (o.steps < 1 || o.steps > 4096) throw Error("--steps must be in [1, 4096] (got " + std::to_string(o.steps) + ")");
+  st.steps = int(o.steps);
+  if (o.noise_size != 32 && o.noise_size != 64 && o.noise_size != 128)
+    throw Error("--noise-size must be 32, 64 or 128 (got " + std::to_string(o.noise_size) + ")");
+  st.noise_size = int(o.noise_size);
+  if (o.noise_seed < 0 || o.noise_seed > 4294967295LL)
+    throw Error("--noise-seed must be in [0, 4294967295] (got " + std::to_string(o.noise_seed) + ")");
+  st.noise_seed = std::uint32_t(o.noise_seed);
+  validate(st);
+
+  // Shadow map: both halves or neither.
+  const bool map = !o.shadow_map_path.empty(), matrix = given(o, "--light-view-proj");
+  if (map && !matrix) throw Error("--shadow-map needs --light-view-proj (the world -> light clip matrix)");
+  if (matrix && !map) throw Error("--light-view-proj needs --shadow-map (the light's depth)");
+  if (o.shadow_reversed_z && !map) throw Error("--shadow-reversed-z needs --shadow-map");
+  if (map) {
+    // The matrix first: a bad matrix fails before the file is read.
+    const glm::mat4 m = parse_light_view_proj(o.light_view_proj);
+    ShadowMapParams p;
+    p.world_to_light_clip = m;
+    p.reversed_z = o.shadow_reversed_z;
+    try {
+      validate(p);
+    } catch (const Error& e) {
+      throw Error(std::string("--light-view-proj: ") + e.what());
+    }
+    s.shadow_ = read_shadow_map(o.shadow_map_path, m, o.shadow_reversed_z);
+  }
+
+  s.volumes_ = read_volumes_json(o.volumes_path);
+  if (runtime != nullptr) s.pass_ = std::make_unique<VolumePass>(*runtime);
+  return stage;
+}
+
+VolumeScene VolumeStage::scene_for(int sequence_frame) const {
+  VolumeScene scene;
+  scene.volumes = volumes_;
+  scene.pose = pose_;
+  scene.light = light_;
+  const bool sequence = sequence_frame >= 0;
+  scene.frame_index = std::uint32_t(given(options_, "--frame") ? options_.frame : sequence ? sequence_frame : 0);
+  scene.time = float(given(options_, "--time") ? options_.time : sequence ? double(sequence_frame) / options_.fps : 0.0);
+  return scene;
+}
+
+void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
+                        int sequence_frame, bool verbose) {
+  const VolumeScene scene = scene_for(sequence_frame);
+  if (pass_)
+    pass_->apply(in, depth, out, camera, scene, settings_, shadow());
+  else
+    apply_volumes_scalar(in, depth, out, camera, scene, settings_, shadow());
+  if (!verbose) return;
+  const std::size_t visible = visible_volumes(scene, camera, max_eye_depth(depth, camera)).size();
+  const int s = settings_.resolution_divisor;
+  std::fprintf(stderr, "volumes: %zu of %zu visible (%s), %s integrator, %d steps, %s resolution (%dx%d target), %s upsampling\n",
+               visible, scene.volumes.size(), options_.volumes_path.c_str(), to_string(settings_.integrator),
+               settings_.steps, resolution_name(s), (in.width() + s - 1) / s, (in.height() + s - 1) / s,
+               to_string(settings_.upsampling));
+  std::fprintf(stderr, "  noise: %d^3 texels, seed %u, %s sampling; shadow map: %s\n", settings_.noise_size,
+               unsigned(settings_.noise_seed), to_string(settings_.noise_sampling),
+               shadow_ ? (std::to_string(shadow_->depth.width()) + "x" + std::to_string(shadow_->depth.height()) +
+                          (shadow_->params.reversed_z ? ", reversed Z" : ", conventional Z"))
+                             .c_str()
+                       : "none (no shadow term)");
+  std::fprintf(stderr, "  frame index %u%s, time %g s%s\n", unsigned(scene.frame_index),
+               given(options_, "--frame") ? " (--frame)" : sequence_frame >= 0 ? " (the frame number)" : " (default)",
+               double(scene.time),
+               given(options_, "--time") ? " (--time)" : sequence_frame >= 0 ? " (frame number / --fps)" : " (default)");
+  if (!pass_)
+    std::fprintf(stderr, "  path: scalar C++ in float (no build options)\n");
+  else if (pass_->last_march_options().empty())
+    std::fprintf(stderr, "  no volume visible: no dispatch, the volumes leave the frame as it was\n");
+  else
+    std::fprintf(stderr, "  march build options: %s\n  composite build options: %s\n", pass_->last_march_options().c_str(),
+                 pass_->last_composite_options().c_str());
+}
+
+}  // namespace fogcl::cli

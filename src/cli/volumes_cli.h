@@ -1,0 +1,99 @@
+// `fogcl apply --volumes`: the volumetric fog volumes pass (DESIGN.md §5) in the CLI. Kept apart
+// from apply.cpp, which only registers the flags (add_volume_options), builds a VolumeStage once
+// per run and calls VolumeStage::apply on each frame before the deferred fog.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/mat4x4.hpp>
+
+#include "fogcl/fogcl.h"
+#include "fogcl/volume_pass.h"
+#include "fogcl/volumes.h"
+
+namespace CLI {
+class App;
+}
+
+namespace fogcl::cli {
+
+// The volume flags as given (vectors as text "X,Y,Z", parsed with messages that name the flag).
+struct VolumeCliOptions {
+  std::string volumes_path;                 // --volumes: "" = no volumetric pass
+  std::string eye, forward, up;             // required with --volumes
+  std::string light_dir = "0,1,0", light_color = "1,1,1";
+  double time = 0.0;                        // --time [s]
+  long long frame = 0;                      // --frame: jitter seed
+  double fps = 24.0;                        // sequences: default time = frame number / fps
+  std::string integrator = "stylized", resolution = "half", upsample = "depth-aware",
+              noise_sampling = "buffer";
+  long long steps = 50, noise_size = 64, noise_seed = 1;
+  std::string shadow_map_path, light_view_proj;
+  bool shadow_reversed_z = false;
+  std::vector<std::string> given;           // the volume flags on the command line
+};
+
+// Registers the volume flags on `fogcl apply`.
+void add_volume_options(CLI::App& apply, VolumeCliOptions& o);
+// After parsing: records which volume flags were given (their defaults depend on it).
+void note_given_volume_flags(const CLI::App& apply, VolumeCliOptions& o);
+
+// VOLUMES.json (README "VOLUMES.json"): {"volumes": [{"center": [x, y, z], "radius": r, ...}]},
+// each key a FogVolume field in snake_case. Throws fogcl::Error, one line: "NAME: volume I: 'KEY'
+// RULE (got VALUE)" for a wrong value, "NAME: ...: parse error at line L, column C: ..." for
+// malformed JSON. Every volume also passes fogcl::validate().
+std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name);
+std::vector<FogVolume> read_volumes_json(const std::string& path);
+// The inverse: every key of each volume (albedo and ambient only when set), parse_volumes_json
+// gives the same floats back.
+std::string volumes_to_json(const std::vector<FogVolume>& volumes);
+
+// "m00,m01,...,m33": 16 numbers, row-major (the first four are the first row) -> GLM's
+// column-major. Throws fogcl::Error naming --light-view-proj for a count, a non-number or a
+// non-finite element; invertibility is ShadowMapParams' validate().
+glm::mat4 parse_light_view_proj(const std::string& text);
+
+// The light's raw depth from channel Z of `path` (or its only channel).
+ShadowMap read_shadow_map(const std::string& path, const glm::mat4& world_to_light_clip, bool reversed_z);
+
+// One run's volumetric pass: the volumes, light, settings and shadow map loaded and checked once;
+// the scene of each frame (jitter index and time) derived from the frame number.
+class VolumeStage {
+ public:
+  // nullptr without --volumes. Throws fogcl::Error, naming the flag, for any bad volume input,
+  // before any frame is read. runtime null: the scalar path.
+  static std::unique_ptr<VolumeStage> create(const VolumeCliOptions& o, const Runtime* runtime);
+
+  // sequence_frame: the frame number in a sequence, -1 for a single file. --frame defaults to it
+  // (0 for a single file), --time to sequence_frame / --fps (0 for a single file).
+  VolumeScene scene_for(int sequence_frame) const;
+  const VolumeSettings& settings() const { return settings_; }
+  const ShadowMap* shadow() const { return shadow_ ? &*shadow_ : nullptr; }
+
+  // Composites the volumes onto `in` into `out` (the OpenCL pass, or the scalar path in float).
+  // verbose: prints the variant (integrator, steps, resolution, visible volumes, build options).
+  void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
+             int sequence_frame, bool verbose);
+
+ private:
+  VolumeCliOptions options_;
+  std::vector<FogVolume> volumes_;
+  CameraPose pose_;
+  MainLight light_;
+  VolumeSettings settings_;
+  std::optional<ShadowMap> shadow_;
+  std::unique_ptr<VolumePass> pass_;  // null: scalar
+};
+
+// `fogcl demo`'s volumetric rows (cli/demo_volumes.cpp): its fog volumes, and the rows run on each
+// backend after the deferred ones; `deferred` is the fog of the row that runs both passes.
+struct DemoOptions;
+class Backend;
+std::vector<FogVolume> demo_volumes();
+void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>& backends,
+                      const FogSettings& deferred);
+
+}  // namespace fogcl::cli
