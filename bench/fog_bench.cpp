@@ -35,6 +35,7 @@
 #include "deferred_fog_cl.h"
 #include "fogcl/demo_scene.h"
 #include "fogcl/fogcl.h"
+#include "runtime/clhpp.h"
 #include "openmp_peer.h"
 
 namespace {
@@ -221,27 +222,38 @@ void BM_OpenCLDevice(benchmark::State& state) {
   const cl_mem_flags host = rt->is_cpu() ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
   timed_fog(state, state.range(5) ? "opencl-device-nt" : "opencl-device", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     // Buffers wrap the same host memory every time (created once per frame and output).
-    static std::map<std::tuple<const void*, const void*, const FogPass*>, FrameBuffers> buffers;
+    // The cl::Buffers own the handles; FrameBuffers borrows them.
+    struct Buffers {
+      cl::Buffer color_in, depth, color_out;
+      FrameBuffers fb;
+    };
+    static std::map<std::tuple<const void*, const void*, const FogPass*>, Buffers> buffers;
     auto key = std::make_tuple(f.color.data(), static_cast<const void*>(out.data()), &pass);
     auto it = buffers.find(key);
+    const cl::Context ctx = wrap(rt->context());
+    const cl::CommandQueue queue = wrap(rt->queue());
     if (it == buffers.end()) {
-      FrameBuffers fb;
-      fb.width = f.color.width();
-      fb.height = f.color.height();
-      fb.format = f.color.format();
-      fb.color_in = cl::Buffer(rt->context(), CL_MEM_READ_ONLY | host, f.color.size_bytes(), const_cast<void*>(f.color.data()));
-      fb.depth = cl::Buffer(rt->context(), CL_MEM_READ_ONLY | host, f.depth.size_bytes(), const_cast<float*>(f.depth.data()));
-      fb.color_out = cl::Buffer(rt->context(), CL_MEM_READ_WRITE | host, out.size_bytes(), out.data());
-      it = buffers.emplace(key, fb).first;
-      pass.enqueue(rt->queue(), fb, f.params, s).wait();  // builds the variant, first dispatch
+      Buffers b;
+      b.color_in = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, f.color.size_bytes(), const_cast<void*>(f.color.data()));
+      b.depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, f.depth.size_bytes(), const_cast<float*>(f.depth.data()));
+      b.color_out = cl::Buffer(ctx, CL_MEM_READ_WRITE | host, out.size_bytes(), out.data());
+      b.fb.width = f.color.width();
+      b.fb.height = f.color.height();
+      b.fb.format = f.color.format();
+      b.fb.color_in = b.color_in();
+      b.fb.depth = b.depth();
+      b.fb.color_out = b.color_out();
+      it = buffers.emplace(key, b).first;
+      pass.prepare(s, f.params, f.color.format());  // builds the variant
+      adopt(pass.enqueue(rt->queue(), b.fb, f.params, s)).wait();  // first dispatch
     }
-    cl::Event e = pass.enqueue(rt->queue(), it->second, f.params, s);
+    const cl::Event e = adopt(pass.enqueue(rt->queue(), it->second.fb, f.params, s));
     e.wait();
     if (!rt->is_cpu())
-      rt->queue().enqueueReadBuffer(it->second.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
+      queue.enqueueReadBuffer(it->second.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
     else  // make the host view of the USE_HOST_PTR output valid (no copy on CPU devices)
-      rt->queue().enqueueUnmapMemObject(it->second.color_out,
-                                        rt->queue().enqueueMapBuffer(it->second.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes()));
+      queue.enqueueUnmapMemObject(it->second.color_out,
+                                  queue.enqueueMapBuffer(it->second.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes()));
     return double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
   });
 }
@@ -321,16 +333,19 @@ void BM_DispatchOverhead(benchmark::State& state) {
   if (rt == nullptr) return;
   FogPass& pass = shared_pass(*rt);
   const DemoFrame& f = frame(1, 1, ColorFormat::rgba32f);
+  const cl::Context ctx = wrap(rt->context());
+  const cl::Buffer color(ctx, CL_MEM_READ_WRITE, 16), depth(ctx, CL_MEM_READ_WRITE, 4), color_out(ctx, CL_MEM_READ_WRITE, 16);
   FrameBuffers fb;
   fb.width = fb.height = 1;
-  fb.color_in = cl::Buffer(rt->context(), CL_MEM_READ_WRITE, 16);
-  fb.depth = cl::Buffer(rt->context(), CL_MEM_READ_WRITE, 4);
-  fb.color_out = cl::Buffer(rt->context(), CL_MEM_READ_WRITE, 16);
+  fb.color_in = color();
+  fb.depth = depth();
+  fb.color_out = color_out();
   FogSettings s;
-  pass.enqueue(rt->queue(), fb, f.params, s).wait();
+  pass.prepare(s, f.params, fb.format);
+  adopt(pass.enqueue(rt->queue(), fb, f.params, s)).wait();
   for (auto _ : state) {
     const auto a = Clock::now();
-    pass.enqueue(rt->queue(), fb, f.params, s).wait();
+    adopt(pass.enqueue(rt->queue(), fb, f.params, s)).wait();
     state.SetIterationTime(seconds_since(a));
   }
 }

@@ -1,4 +1,4 @@
-/* deferred_fog.cl — the full-screen deferred fog pass (DESIGN.md §2).
+/* deferred_fog.cl — the full-screen deferred fog pass (docs/DESIGN.md §2).
  *
  * Variant switches, set by the host's build_options(); a variant holds no code for a feature the
  * scene does not use:

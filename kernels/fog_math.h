@@ -1,4 +1,4 @@
-/* fog_math.h — the per-pixel formulas of DESIGN.md §2, written once and compiled three ways:
+/* fog_math.h — the per-pixel formulas of docs/DESIGN.md §2, written once and compiled three ways:
  *   - OpenCL C on one pixel:       FOG_REAL float,   FOG_INT int,   FOG_NAME(f) f
  *   - OpenCL C on 16 pixels:       FOG_REAL float16, FOG_INT int16, FOG_NAME(f) f##_v
  *     (vector lanes are independent pixels; every operation is lane-wise IEEE, so a lane rounds
@@ -199,7 +199,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL q, FOG_REAL k, int squared) {
   return FOG_EXP2(fma(-t, t, (FOG_REAL)0)); /* -(t * t) in one fused negative multiply */
 }
 
-/* The distance of DESIGN.md §2 from a raw depth, and whether the pixel is sky: q = d, or d^2
+/* The distance of docs/DESIGN.md §2 from a raw depth, and whether the pixel is sky: q = d, or d^2
  * where `squared` (FOG_SQUARED: distance-based exp2). The int parameters are compile-time
  * constants in the kernel, so the branches a variant does not use fold away. ray = fog_ray_term
  * (|ray(u, v)|, or its square) is read only when distance-based (perspective only: with parallel
@@ -253,7 +253,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_amount_at)(FOG_REAL q, FOG_INT sky, int mode, int s
   return fog_skybox ? FOG_NAME(fog_saturate)(a) : (sky ? (FOG_REAL)0 : FOG_NAME(fog_saturate)(a));
 }
 
-/* The fog factor f of a pixel from its raw depth: the whole chain of DESIGN.md §2. */
+/* The fog factor f of a pixel from its raw depth: the whole chain of docs/DESIGN.md §2. */
 FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray, int mode, int distance,
                                      int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
                                      FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,

@@ -4,7 +4,7 @@ set -euo pipefail
 packages=(
   cmake g++ make
   pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers opencl-clhpp-headers
-  libglm-dev libopenexr-dev libpng-dev libcli11-dev nlohmann-json3-dev
+  libglm-dev libimath-dev libopenexr-dev libpng-dev libcli11-dev nlohmann-json3-dev pkg-config
   libgtest-dev libbenchmark-dev
 )
 # --sanitizers: also clang and its runtimes (libFuzzer, ASan, UBSan) for `make asan-test` / `make fuzz`.

@@ -1,4 +1,4 @@
-// Blend and NaN rules of DESIGN.md §2 on the kernel and the scalar path, f32 and f16 storage:
+// Blend and NaN rules of docs/DESIGN.md §2 on the kernel and the scalar path, f32 and f16 storage:
 // f == 1 leaves the pixel bit-exact, f == 0 writes exactly the fog color, alpha passes through,
 // a NaN at 0 < f < 1 stays in its channel, finite input never gives non-finite output, and fog
 // off / density 0 dispatch nothing and copy bit for bit.

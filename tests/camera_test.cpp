@@ -1,4 +1,4 @@
-// Unit tests of the camera constants (DESIGN.md §2): _ZBufferParams, _ProjectionParams, frustum
+// Unit tests of the camera constants (docs/DESIGN.md §2): _ZBufferParams, _ProjectionParams, frustum
 // corners, Unity corner order, camera recovery from GLM projection matrices and validation.
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-// DESIGN.md §2 conventions, checked on the kernel (and the scalar path) with inputs whose answer
+// docs/DESIGN.md §2 conventions, checked on the kernel (and the scalar path) with inputs whose answer
 // is known independently: uv orientation and corner order, depth- vs distance-based distance,
 // conventional vs reversed Z.
 #include <cmath>
@@ -49,24 +49,39 @@ class Conventions : public ::testing::TestWithParam<bool /*scalar*/> {
   }
 };
 
-// One corner ray made 4x longer than the others must lengthen the distance of the pixel next to
-// that corner most: checks both the corner order (u + 2v) and that v grows upwards.
+// One side of the frustum made 4x wider must lengthen the distances of the pixels on that side:
+// checks both the corner order (u + 2v) and that v grows upwards.
 TEST_P(Conventions, CornerOrderAndUvOrientation) {
   PerspectiveCamera camera;
   camera.aspect = 1.0f;
   const CameraParams base = make_camera_params(camera);
   DepthImage depth(2, 2, 0.5f);
-  // Pixel next to each corner: BL = (0, 1), BR = (1, 1), TL = (0, 0), TR = (1, 0) (row 0 = top).
-  const int px[4] = {0, 1, 0, 1}, py[4] = {1, 1, 0, 0};
-  for (int corner = 0; corner < 4; ++corner) {
+  // Only valid cameras reach a pass (validate: the corners a rectangle on the far plane), so the
+  // frustum is widened on one side at a time (off-centre); the two pixels on that side see
+  // longer rays. Pixels: TL = 0, TR = 1, BL = 2, BR = 3 (row 0 = top).
+  struct Side {
+    const char* name;
+    int axis;             // 0: x, 1: y
+    Corner a, b;          // the side's corners
+    std::size_t pa, pb;   // the side's pixels
+  };
+  const Side sides[] = {{"right", 0, kBottomRight, kTopRight, 3, 1},
+                        {"left", 0, kBottomLeft, kTopLeft, 2, 0},
+                        {"top", 1, kTopLeft, kTopRight, 0, 1},
+                        {"bottom", 1, kBottomLeft, kBottomRight, 2, 3}};
+  for (const Side& side : sides) {
     CameraParams cam = base;
-    cam.frustum_corners[corner] *= 4.0f;
+    cam.frustum_corners[side.a][side.axis] *= 4.0f;
+    cam.frustum_corners[side.b][side.axis] *= 4.0f;
     const std::vector<double> d = measured_distance(depth, cam, FogMetric::distance, GetParam());
-    const std::size_t expect = std::size_t(py[corner]) * 2 + px[corner];
+    double ratio = 1e30;
     for (std::size_t i = 0; i < 4; ++i)
-      if (i != expect) {
-        EXPECT_GT(d[expect], d[i] * 1.5) << "corner " << corner << " pixel " << i;
-      }
+      if (i != side.pa && i != side.pb)
+        for (std::size_t p : {side.pa, side.pb}) {
+          EXPECT_GT(d[p], d[i] * 1.5) << side.name << " side: pixel " << p << " vs " << i;
+          ratio = std::min(ratio, d[p] / d[i]);
+        }
+    std::printf("[ info     ] %s side widened: smallest distance ratio side/other %.3f (> 1.5)\n", side.name, ratio);
   }
 }
 

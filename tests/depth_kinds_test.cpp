@@ -1,5 +1,5 @@
 // Depth kinds (src/io/depth_kinds.cpp): eye depth and radial distance to raw device depth, checked
-// by going back with the formulas of DESIGN.md §2 in double and with the camera's geometry.
+// by going back with the formulas of docs/DESIGN.md §2 in double and with the camera's geometry.
 #include <cmath>
 #include <limits>
 

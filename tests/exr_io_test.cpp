@@ -1,4 +1,4 @@
-// EXR and PNG I/O (src/io): round trips, windows (DESIGN.md §2: the display window is the frame),
+// EXR and PNG I/O (src/io): round trips, windows (docs/DESIGN.md §2: the display window is the frame),
 // bad input, the temp-and-rename writers, and the dithered sRGB PNG preview.
 //
 // Files that feed the readers are written with OpenEXR directly (write_raw_exr), so the readers
@@ -351,7 +351,7 @@ TEST_F(ExrIoTest, AbsurdDisplayWindowIsRejectedBeforeAllocating) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Windows (DESIGN.md §2)
+// Windows (docs/DESIGN.md §2)
 
 TEST_F(ExrIoTest, DataWindowInsideDisplayWindowKeepsPixelPositions) {
   const Imath::Box2i display = box(-3, -2, 12, 9);  // 16 x 12 frame

@@ -1,4 +1,4 @@
-// Unit tests of the host images (DESIGN.md §1, §2): sizes, alignment, half conversion, typed
+// Unit tests of the host images (docs/DESIGN.md §1, §2): sizes, alignment, half conversion, typed
 // access, value semantics, format conversion and frame validation.
 #include <algorithm>
 #include <cmath>

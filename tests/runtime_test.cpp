@@ -4,7 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <memory>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -133,7 +136,7 @@ TEST(RuntimeTest, EnvGuardRestores) {
 
 TEST(RuntimeTest, FindDeviceUnknownListsAvailable) {
   FOGCL_REQUIRE_DEVICE();
-  const std::string name = test::runtime()->device().getInfo<CL_DEVICE_NAME>();
+  const std::string name = device_name(test::runtime()->device());
   try {
     find_device("no-such-device-xyz");
     ADD_FAILURE() << "no exception for an unknown device";
@@ -149,17 +152,17 @@ TEST(RuntimeTest, FindDeviceUnknownListsAvailable) {
 
 TEST(RuntimeTest, FindDeviceByNameIsCaseInsensitive) {
   FOGCL_REQUIRE_DEVICE();
-  const cl::Device want = test::runtime()->device();
-  std::string name = want.getInfo<CL_DEVICE_NAME>();
+  const cl_device_id want = test::runtime()->device();
+  std::string name = device_name(want);
   for (char& c : name) c = char(std::toupper(static_cast<unsigned char>(c)));
-  const cl::Device got = find_device(name);
-  EXPECT_EQ(got.getInfo<CL_DEVICE_NAME>(), want.getInfo<CL_DEVICE_NAME>());
+  const cl_device_id got = find_device(name);
+  EXPECT_EQ(device_name(got), device_name(want));
 }
 
 TEST(RuntimeTest, FindDeviceCpu) {
   FOGCL_REQUIRE_DEVICE();
   if (!test::runtime()->is_cpu()) GTEST_SKIP() << "the test device is not a CPU device";
-  const cl::Device d = find_device("cpu");
+  const cl_device_id d = find_device("cpu");
   EXPECT_TRUE(device_is_cpu(d));
   EXPECT_TRUE(device_is_cpu(find_device("CPU")));
 }
@@ -170,10 +173,10 @@ TEST(RuntimeTest, FindDeviceCpu) {
 TEST(RuntimeTest, DescriptionNamesTheDevice) {
   FOGCL_REQUIRE_DEVICE();
   const Runtime& rt = *test::runtime();
-  const std::string name = rt.device().getInfo<CL_DEVICE_NAME>();
+  const std::string name = device_name(rt.device());
   const std::string desc = rt.description();
   EXPECT_MSG_HAS(desc, name);
-  const std::string platform = cl::Platform(rt.device().getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_NAME>();
+  const std::string platform = cl::Platform(wrap(rt.device()).getInfo<CL_DEVICE_PLATFORM>()).getInfo<CL_PLATFORM_NAME>();
   EXPECT_MSG_HAS(desc, platform);
   std::printf("[ info ] device: %s\n", desc.c_str());
   // The integration constructor describes the same device.
@@ -190,7 +193,7 @@ TEST(RuntimeTest, DefaultDeviceIsCpu) {
   EXPECT_TRUE(device_is_cpu(test::runtime()->device()));
   const Runtime cpu("cpu");
   EXPECT_TRUE(cpu.is_cpu());
-  EXPECT_EQ(cpu.device().getInfo<CL_DEVICE_NAME>(), test::runtime()->device().getInfo<CL_DEVICE_NAME>());
+  EXPECT_EQ(device_name(cpu.device()), device_name(test::runtime()->device()));
 }
 
 TEST(RuntimeTest, UnknownDeviceRuntimeThrows) {
@@ -240,33 +243,36 @@ TEST(ProgramCacheTest, SyntaxErrorThrowsWithBuildLog) {
 
 TEST(ProgramCacheTest, CachesByDeviceSourceNameAndOptions) {
   FOGCL_REQUIRE_DEVICE();
-  const cl::Device& device = test::runtime()->device();
+  const cl_device_id device = test::runtime()->device();
   ProgramCache cache(test::runtime()->context());
   EXPECT_EQ(cache.builds(), 0u);
-  EXPECT_EQ(cache.context()(), test::runtime()->context()());
+  EXPECT_EQ(cache.context(), test::runtime()->context());
+  EXPECT_EQ(cache.find(device, "good.cl", "-cl-std=CL1.2"), nullptr) << "find() before any build";
 
-  const cl::Program p1 = cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2");
+  const cl_program p1 = cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2");
   EXPECT_EQ(cache.builds(), 1u);
-  const cl::Program p2 = cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2");
+  const cl_program p2 = cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2");
   EXPECT_EQ(cache.builds(), 1u) << "the same key must not build again";
-  EXPECT_EQ(p1(), p2()) << "the same key must return the cached program";
+  EXPECT_EQ(p1, p2) << "the same key must return the cached program";
 
-  const cl::Program p3 = cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2 -D UNUSED=1");
+  const cl_program p3 = cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2 -D UNUSED=1");
   EXPECT_EQ(cache.builds(), 2u) << "different options must build";
-  EXPECT_NE(p3(), p1());
-  const cl::Program p4 = cache.get(device, "other.cl", kGoodSource, "-cl-std=CL1.2");
+  EXPECT_NE(p3, p1);
+  const cl_program p4 = cache.get(device, "other.cl", kGoodSource, "-cl-std=CL1.2");
   EXPECT_EQ(cache.builds(), 3u) << "a different source name must build";
-  EXPECT_NE(p4(), p1());
+  EXPECT_NE(p4, p1);
+  EXPECT_EQ(cache.find(device, "good.cl", "-cl-std=CL1.2"), p1) << "find() returns the built program";
+  EXPECT_EQ(cache.builds(), 3u) << "find() never builds";
 
   cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2 -D UNUSED=1");
   cache.get(device, "other.cl", kGoodSource, "-cl-std=CL1.2");
   EXPECT_EQ(cache.builds(), 3u);
 
   // The cached program is usable.
-  cl::Kernel kernel(p2, "scale");
-  cl::Buffer buf(test::runtime()->context(), CL_MEM_READ_WRITE, 4 * sizeof(float));
+  cl::Kernel kernel(wrap(p2), "scale");
+  cl::Buffer buf(wrap(test::runtime()->context()), CL_MEM_READ_WRITE, 4 * sizeof(float));
   const float in[4] = {1, 2, 3, -4};
-  const cl::CommandQueue& q = test::runtime()->queue();
+  const cl::CommandQueue q = wrap(test::runtime()->queue());
   q.enqueueWriteBuffer(buf, CL_TRUE, 0, sizeof in, in);
   kernel.setArg(0, buf);
   kernel.setArg(1, 2.5f);
@@ -290,5 +296,32 @@ TEST(ProgramCacheTest, InvalidOptionsThrowClError) {
   EXPECT_EQ(cache.builds(), 0u);
 }
 
+}  // namespace
+}  // namespace fogcl
+
+namespace fogcl {
+namespace {
+// Several threads asking one cache for the same program at once: one build, one program; other
+// keys asked meanwhile are built too (a build does not hold the cache's lock).
+TEST(ProgramCacheTest, ThreadsShareOneBuildPerKey) {
+  FOGCL_REQUIRE_DEVICE();
+  const cl_device_id device = test::runtime()->device();
+  auto cache = std::make_shared<ProgramCache>(test::runtime()->context());
+  constexpr int kThreads = 6;
+  std::vector<cl_program> got(kThreads, nullptr);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kThreads; ++i)
+    threads.emplace_back([&, i] {
+      // Threads 0..3 want the same program; 4 and 5 another one each.
+      const std::string options = "-cl-std=CL1.2 -D THREAD_KEY=" + std::to_string(i < 4 ? 0 : i);
+      got[i] = cache->get(device, "good.cl", kGoodSource, options);
+    });
+  for (auto& t : threads) t.join();
+  std::printf("[ info ] %d threads, %zu builds\n", kThreads, cache->builds());
+  EXPECT_EQ(cache->builds(), 3u);
+  for (int i = 1; i < 4; ++i) EXPECT_EQ(got[i], got[0]) << "thread " << i;
+  EXPECT_NE(got[4], got[0]);
+  EXPECT_NE(got[5], got[4]);
+}
 }  // namespace
 }  // namespace fogcl

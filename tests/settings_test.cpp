@@ -1,5 +1,5 @@
 // Unit tests of the fog settings validation, variant selection and build options
-// (DESIGN.md §2, §3), and of the per-variant program cache of the pass.
+// (docs/DESIGN.md §2, §3), and of the per-variant program cache of the pass.
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -397,7 +397,7 @@ TEST(VariantTest, Describe) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// One program per distinct variant (DESIGN.md §3), via the pass's program cache.
+// One program per distinct variant (docs/DESIGN.md §3), via the pass's program cache.
 
 TEST(VariantTest, PrepareBuildsOncePerDistinctVariantOwnPass) {
   FOGCL_REQUIRE_DEVICE();

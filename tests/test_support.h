@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "fogcl/fogcl.h"
+#include "runtime/clhpp.h"  // the tests drive OpenCL through fogcl's private CLHPP settings
 
 namespace fogcl::test {
 

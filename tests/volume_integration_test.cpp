@@ -13,27 +13,32 @@ class VolumeIntegration : public ::testing::Test {
  protected:
   void SetUp() override {
     FOGCL_REQUIRE_DEVICE();
-    ctx = runtime()->context();
-    queue = cl::CommandQueue(ctx, runtime()->device());
+    ctx = wrap(runtime()->context());
+    queue = cl::CommandQueue(ctx, wrap(runtime()->device()));
     t = volume_test_scene(80, 45);
     settings.steps = 16;
   }
+  // Buffers the test keeps alive; FrameBuffers borrows their handles.
   FrameBuffers buffers(bool in_place) {
+    color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, t.frame.color.size_bytes(),
+                          const_cast<void*>(t.frame.color.data()));
+    depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, t.frame.depth.size_bytes(),
+                       const_cast<float*>(t.frame.depth.data()));
+    color_out = in_place ? color_in : cl::Buffer(ctx, CL_MEM_READ_WRITE, t.frame.color.size_bytes());
     FrameBuffers fb;
     fb.width = t.frame.color.width();
     fb.height = t.frame.color.height();
-    fb.color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, t.frame.color.size_bytes(),
-                             const_cast<void*>(t.frame.color.data()));
-    fb.depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, t.frame.depth.size_bytes(),
-                          const_cast<float*>(t.frame.depth.data()));
-    fb.color_out = in_place ? fb.color_in : cl::Buffer(ctx, CL_MEM_READ_WRITE, t.frame.color.size_bytes());
+    fb.color_in = color_in();
+    fb.depth = depth();
+    fb.color_out = color_out();
     return fb;
   }
-  ColorImage read(const cl::Buffer& b) {
+  ColorImage read(cl_mem b) {
     ColorImage out(t.frame.color.width(), t.frame.color.height());
-    queue.enqueueReadBuffer(b, CL_TRUE, 0, out.size_bytes(), out.data());
+    queue.enqueueReadBuffer(wrap(b), CL_TRUE, 0, out.size_bytes(), out.data());
     return out;
   }
+  cl::Buffer color_in, depth, color_out;
   cl::Context ctx;
   cl::CommandQueue queue;
   VolumeTestScene t;
@@ -41,12 +46,15 @@ class VolumeIntegration : public ::testing::Test {
 };
 
 TEST_F(VolumeIntegration, WaitsOnCallerEventsNeverBlocksAndMatchesTheConvenienceApi) {
-  VolumePass pass(ctx, runtime()->device());
-  pass.prepare(t.frame.params, t.scene, settings, ColorFormat::rgba32f);
+  VolumePass pass(ctx(), runtime()->device());
   const FrameBuffers fb = buffers(false);
+  // enqueue never builds: an unprepared variant is an error that says what to call.
+  EXPECT_MSG_HAS(error_of([&] { pass.enqueue(queue(), fb, t.frame.params, t.scene, settings); }),
+                 "is not prepared: call VolumePass::prepare");
+  pass.prepare(t.frame.params, t.scene, settings, ColorFormat::rgba32f);
   cl::UserEvent gate(ctx);
   // A hidden finish inside enqueue would hang here: the gate opens only below.
-  const cl::Event done = pass.enqueue(queue, fb, t.frame.params, t.scene, settings, nullptr, {gate});
+  const cl::Event done = adopt(pass.enqueue(queue(), fb, t.frame.params, t.scene, settings, nullptr, {gate()}));
   EXPECT_NE(done.getInfo<CL_EVENT_COMMAND_EXECUTION_STATUS>(), CL_COMPLETE);
   EXPECT_EQ(pass.stats().march_dispatches, 1u);
   EXPECT_EQ(pass.stats().composite_dispatches, 1u);
@@ -58,7 +66,7 @@ TEST_F(VolumeIntegration, WaitsOnCallerEventsNeverBlocksAndMatchesTheConvenience
   EXPECT_EQ(std::memcmp(got.data(), expected.data(), got.size_bytes()), 0);
   // In place gives the same bytes.
   const FrameBuffers in_place = buffers(true);
-  pass.enqueue(queue, in_place, t.frame.params, t.scene, settings).wait();
+  adopt(pass.enqueue(queue(), in_place, t.frame.params, t.scene, settings)).wait();
   const ColorImage got_in_place = read(in_place.color_out);
   EXPECT_EQ(std::memcmp(got_in_place.data(), expected.data(), got.size_bytes()), 0);
   EXPECT_EQ(pass.stats().noise_uploads, 1u) << "the noise texture is uploaded once and reused";
@@ -76,9 +84,9 @@ TEST_F(VolumeIntegration, NothingVisibleMeansNoDispatchAndTheInputBitForBit) {
   float* c = t.frame.color.rgba32f();
   c[0] = std::numeric_limits<float>::quiet_NaN();
   c[5] = INFINITY;
-  VolumePass pass(ctx, runtime()->device());
+  VolumePass pass(ctx(), runtime()->device());
   const FrameBuffers fb = buffers(false);
-  pass.enqueue(queue, fb, t.frame.params, t.scene, settings).wait();
+  adopt(pass.enqueue(queue(), fb, t.frame.params, t.scene, settings)).wait();
   EXPECT_EQ(pass.stats().march_dispatches, 0u);
   EXPECT_EQ(pass.stats().frames_without_volumes, 1u);
   EXPECT_EQ(pass.stats().volumes_culled, 2u);

@@ -64,7 +64,7 @@ TEST_P(VolumeKernelFeatures, WithinBudget) {
   const bool with_shadow = feature <= 1;
   if (with_shadow) shadow = synthetic_shadow_map(feature == 1);
   if (feature == 3) {
-    if (runtime()->device().getInfo<CL_DEVICE_IMAGE_SUPPORT>() != CL_TRUE) GTEST_SKIP() << "no image support";
+    if (wrap(runtime()->device()).getInfo<CL_DEVICE_IMAGE_SUPPORT>() != CL_TRUE) GTEST_SKIP() << "no image support";
     settings.noise_sampling = NoiseSampling::image;
   }
   ColorImage out;

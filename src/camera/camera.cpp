@@ -1,5 +1,6 @@
 #include "fogcl/camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -14,6 +15,78 @@ std::string str(T v) {
   s.precision(9);
   s << v;
   return s.str();
+}
+
+std::string str(const glm::vec3& v) { return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ")"; }
+std::string str(const glm::vec4& v) {
+  return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ", " + str(v.w) + ")";
+}
+
+// The one place the constants are computed from near and far (make_camera_params builds them,
+// validate checks handed-in ones against them). Float arithmetic, as Unity's
+// UnityShaderVariables / Camera.cpp (x loses its 1 once far/near >= 2^24; the kernel does not
+// depend on x for conventional Z).
+glm::vec4 zbuffer_params_for(Projection projection, float n, float f, bool reversed_z) {
+  switch (projection) {
+    case Projection::perspective_infinite_far:
+      return glm::vec4(0.0f, 0.0f, 1.0f / n, 0.0f);  // eye depth = near / raw
+    case Projection::orthographic: {
+      // Eye depth = lerp(near, far, raw) (raw = 1 - raw with reversed Z), as Unity's
+      // orthographic depth; Linear01Depth = eye / far.
+      const float range = (f - n) / f;
+      return reversed_z ? glm::vec4(-range, 1.0f, -(f - n), f) : glm::vec4(range, n / f, f - n, n);
+    }
+    case Projection::perspective:
+      break;
+  }
+  if (reversed_z) {
+    const float x = -1.0f + f / n;
+    return glm::vec4(x, 1.0f, x / f, 1.0f / f);
+  }
+  const float y = f / n;
+  const float x = 1.0f - y;
+  return glm::vec4(x, y, x / f, y / f);
+}
+
+glm::vec4 projection_params_for(Projection projection, float n, float f) {
+  return projection == Projection::perspective_infinite_far ? glm::vec4(1.0f, n, INFINITY, 0.0f)
+                                                            : glm::vec4(1.0f, n, f, 1.0f / f);
+}
+
+// Handed-in constants agree with computed ones to this relative tolerance: far above float
+// rounding (a user computing in double, Unity in float), far below any real inconsistency.
+constexpr float kRelTol = 1e-4f;
+bool close(float got, float want, float scale) { return std::fabs(got - want) <= kRelTol * scale; }
+
+const char* projection_name(Projection p) {
+  return p == Projection::orthographic ? "orthographic"
+         : p == Projection::perspective_infinite_far ? "perspective infinite-far"
+                                                     : "perspective";
+}
+
+// _ZBufferParams against near, far, the projection and the Z direction; `what` names the source
+// of the values in the message.
+void check_zbuffer_params(const glm::vec4& zb, Projection projection, float n, float f, bool reversed_z,
+                          const std::string& what) {
+  for (int c = 0; c < 4; ++c)
+    if (!std::isfinite(zb[c]))
+      throw Error(what + ": _ZBufferParams component " + std::to_string(c) + " is not finite (got " + str(zb[c]) + ")");
+  const glm::vec4 e = zbuffer_params_for(projection, n, f, reversed_z);
+  const float xy = std::max(std::fabs(e.x), std::fabs(e.y)), zw = std::max(std::fabs(e.z), std::fabs(e.w));
+  if (close(zb.x, e.x, xy) && close(zb.y, e.y, xy) && close(zb.z, e.z, zw) && close(zb.w, e.w, zw)) return;
+  const std::string z = reversed_z ? "reversed_z = true" : "reversed_z = false";
+  std::string hint;
+  if (projection != Projection::perspective_infinite_far) {
+    const glm::vec4 other = zbuffer_params_for(projection, n, f, !reversed_z);
+    const float oxy = std::max(std::fabs(other.x), std::fabs(other.y));
+    if (close(zb.x, other.x, oxy) && close(zb.y, other.y, oxy))
+      hint = reversed_z ? ": these are conventional-Z values (y = " + str(zb.y) + " != 1), set reversed_z = false"
+                        : ": these are reversed-Z values (y = 1), set reversed_z = true";
+  }
+  throw Error(what + ": _ZBufferParams " + str(zb) + " do not match near " + str(n) + ", far " + str(f) + ", " +
+              projection_name(projection) + ", " + z + " (expected " + str(e) +
+              "; perspective: conventional (1 - far/near, far/near, x/far, y/far), reversed "
+              "(far/near - 1, 1, x/far, 1/far))" + hint);
 }
 }  // namespace
 
@@ -61,27 +134,12 @@ CameraParams make_camera_params(const PerspectiveCamera& c) {
     p.frustum_corners[kTopLeft] = glm::vec3(float(-half_w), float(half_h), float(z));
     p.frustum_corners[kTopRight] = glm::vec3(float(half_w), float(half_h), float(z));
   };
-  if (c.infinite_far) {
-    // Eye depth = near / raw; the rays are normalised to view z = 1 so that distance = eye * |ray|.
-    p.projection = Projection::perspective_infinite_far;
-    p.zbuffer_params = glm::vec4(0.0f, 0.0f, 1.0f / n, 0.0f);
-    p.projection_params = glm::vec4(1.0f, n, INFINITY, 0.0f);
-    corners(1.0);
-    return p;
-  }
-  // UnityShaderVariables / Camera.cpp: float arithmetic, as Unity does (x loses its 1 once
-  // far/near >= 2^24; the kernel does not depend on x for conventional Z).
-  if (c.reversed_z) {
-    const float x = -1.0f + f / n;
-    p.zbuffer_params = glm::vec4(x, 1.0f, x / f, 1.0f / f);
-  } else {
-    const float y = f / n;
-    const float x = 1.0f - y;
-    p.zbuffer_params = glm::vec4(x, y, x / f, y / f);
-  }
-  p.projection_params = glm::vec4(1.0f, n, f, 1.0f / f);
-  // Camera.CalculateFrustumCorners(rect 0..1, far): the far-plane rectangle in view space.
-  corners(double(f));
+  p.projection = c.infinite_far ? Projection::perspective_infinite_far : Projection::perspective;
+  p.zbuffer_params = zbuffer_params_for(p.projection, n, f, c.reversed_z);
+  p.projection_params = projection_params_for(p.projection, n, f);
+  // Camera.CalculateFrustumCorners(rect 0..1, far): the far-plane rectangle in view space;
+  // infinite far: normalised to view z = 1 so that distance = eye * |ray|.
+  corners(c.infinite_far ? 1.0 : double(f));
   return p;
 }
 
@@ -91,11 +149,8 @@ CameraParams make_camera_params(const OrthographicCamera& c) {
   CameraParams p;
   p.projection = Projection::orthographic;
   p.reversed_z = c.reversed_z;
-  // Eye depth = lerp(near, far, raw) (raw = 1 - raw with reversed Z), as Unity's orthographic
-  // depth; Linear01Depth = eye / far.
-  const float range = (f - n) / f;
-  p.zbuffer_params = c.reversed_z ? glm::vec4(-range, 1.0f, -(f - n), f) : glm::vec4(range, n / f, f - n, n);
-  p.projection_params = glm::vec4(1.0f, n, f, 1.0f / f);
+  p.zbuffer_params = zbuffer_params_for(p.projection, n, f, c.reversed_z);
+  p.projection_params = projection_params_for(p.projection, n, f);
   const float half_h = c.ortho_size, half_w = c.ortho_size * c.aspect;
   p.frustum_corners[kBottomLeft] = glm::vec3(-half_w, -half_h, f);
   p.frustum_corners[kBottomRight] = glm::vec3(half_w, -half_h, f);
@@ -160,31 +215,93 @@ std::array<glm::vec3, 4> corners_from_unity_order(const std::array<glm::vec3, 4>
 namespace fogcl {
 void validate(const CameraParams& p) {
   const float n = p.near_plane(), f = p.far_plane();
-  if (!(n > 0.0f) || !std::isfinite(n))
-    throw Error("camera params: near (_ProjectionParams.y) must be finite and > 0 (got " + str(n) + ")");
   const bool infinite = p.projection == Projection::perspective_infinite_far;
-  if (infinite && !p.reversed_z)
-    throw Error("camera params: an infinite far plane needs reversed Z");
-  if (!(f > n) || (!infinite && !std::isfinite(f)))
-    throw Error("camera params: far (_ProjectionParams.z) must be finite and > near (got " + str(f) + ")");
-  for (int c = 0; c < 4; ++c)
-    if (!std::isfinite(p.zbuffer_params[c]))
-      throw Error("camera params: _ZBufferParams component " + std::to_string(c) + " is not finite (got " +
-                  str(p.zbuffer_params[c]) + ")");
-  // Linear01Depth must be positive over the whole depth range [0, 1]. Perspective, conventional:
-  // y = far/near >= 1 (x is not used: fog_math.h evaluates y (1 - raw) + raw); reversed: y > 0 and
-  // x + y > 0. Orthographic: x * raw + y >= 0 (its near plane may be at 0).
-  const float zx = p.zbuffer_params.x, zy = p.zbuffer_params.y;
-  const bool ok = p.projection == Projection::orthographic ? zy >= 0.0f && zx + zy >= 0.0f
-                  : p.projection == Projection::perspective_infinite_far ? p.zbuffer_params.z > 0.0f
-                  : p.reversed_z ? zy > 0.0f && zx + zy > 0.0f
-                                 : zy >= 1.0f;
-  if (!ok)
-    throw Error("camera params: _ZBufferParams (" + str(zx) + ", " + str(zy) +
-                ") do not describe a perspective depth range (need y > 0 and x + y > 0)");
-  for (const glm::vec3& c : p.frustum_corners)
+  const bool ortho = p.projection == Projection::orthographic;
+  const glm::vec4& pp = p.projection_params;
+  if (pp.x != 1.0f) {
+    if (pp.x == -1.0f)
+      throw Error("camera params: _ProjectionParams.x = -1 (Unity's flipped projection, rendering upside down into "
+                  "a render texture) is not supported: fogcl's row 0 is the top of the view; flip the rows and pass "
+                  "_ProjectionParams.x = 1");
+    throw Error("camera params: _ProjectionParams.x must be 1 (got " + str(pp.x) + ")");
+  }
+  if (!(ortho ? n >= 0.0f : n > 0.0f) || !std::isfinite(n))
+    throw Error(std::string("camera params: near (_ProjectionParams.y) must be finite and ") +
+                (ortho ? ">= 0" : "> 0") + " (got " + str(n) + ")");
+  if (infinite && !p.reversed_z) throw Error("camera params: an infinite far plane needs reversed Z");
+  if (infinite ? f != INFINITY : !(f > n) || !std::isfinite(f) || (!ortho && !std::isfinite(f / n)))
+    throw Error("camera params: far (_ProjectionParams.z) must be " +
+                std::string(infinite ? "+inf for the infinite-far projection" : "finite and > near, far/near finite") +
+                " (got far " + str(f) + ", near " + str(n) + ")");
+  const float w = infinite ? 0.0f : 1.0f / f;
+  if (!close(pp.w, w, w))
+    throw Error("camera params: _ProjectionParams.w must be 1 / far = " + str(w) + " (got " + str(pp.w) + ")");
+  check_zbuffer_params(p.zbuffer_params, p.projection, n, f, p.reversed_z, "camera params");
+
+  const auto& c = p.frustum_corners;
+  for (const glm::vec3& corner : c)
     for (int k = 0; k < 3; ++k)
-      if (!std::isfinite(c[k]))
-        throw Error("camera params: frustum corner component is not finite (got " + str(c[k]) + ")");
+      if (!std::isfinite(corner[k]))
+        throw Error("camera params: frustum corner component is not finite (got " + str(corner[k]) + ")");
+  const std::string got = " (got bottom-left " + str(c[kBottomLeft]) + ", bottom-right " + str(c[kBottomRight]) +
+                          ", top-left " + str(c[kTopLeft]) + ", top-right " + str(c[kTopRight]) + ")";
+  if (!(c[kBottomLeft].x < c[kBottomRight].x && c[kTopLeft].x < c[kTopRight].x &&
+        c[kBottomLeft].y < c[kTopLeft].y && c[kBottomRight].y < c[kTopRight].y))
+    throw Error("camera params: frustum corners are not in fogcl's order bottom-left, bottom-right, top-left, "
+                "top-right (left x < right x, bottom y < top y)" + got +
+                "; Unity's CalculateFrustumCorners order (bottom-left, top-left, top-right, bottom-right) needs "
+                "corners_from_unity_order() or camera_params_from_unity()");
+  float extent = 0.0f;
+  for (const glm::vec3& corner : c) extent = std::max({extent, std::fabs(corner.x), std::fabs(corner.y)});
+  if (!(close(c[kBottomLeft].x, c[kTopLeft].x, extent) && close(c[kBottomRight].x, c[kTopRight].x, extent) &&
+        close(c[kBottomLeft].y, c[kBottomRight].y, extent) && close(c[kTopLeft].y, c[kTopRight].y, extent)))
+    throw Error("camera params: frustum corners do not form a rectangle (left corners share x, bottom corners "
+                "share y, ...)" + got);
+  const float plane = infinite ? 1.0f : f;
+  for (int k = 0; k < 4; ++k)
+    if (!close(c[k].z, plane, plane))
+      throw Error("camera params: frustum corner " + std::to_string(k) + " has z = " + str(c[k].z) + " but " +
+                  (infinite ? std::string("infinite-far corners are normalised to z = 1")
+                            : "the corners lie on the far plane, z = far = " + str(f) +
+                                  " (CalculateFrustumCorners with farClipPlane)") + got);
+}
+
+CameraParams camera_params_from_unity(const UnityCameraConstants& u) {
+  const std::string what = "Unity camera constants";
+  const float w = u.ortho_params.w;
+  if (w != 0.0f && w != 1.0f)
+    throw Error(what + ": unity_OrthoParams.w must be 0 (perspective) or 1 (orthographic) (got " + str(w) + ")");
+  const float n = u.projection_params.y, f = u.projection_params.z;
+  if (!std::isfinite(f))
+    throw Error(what + ": _ProjectionParams.z (far) = " + str(f) + ": Unity cameras have a finite far plane (for "
+                "fogcl's infinite-far variant use make_camera_params on a PerspectiveCamera with infinite_far)");
+  const auto& uc = u.frustum_corners;  // bottom-left, top-left, top-right, bottom-right
+  if (!(uc[0].x < uc[3].x && uc[1].x < uc[2].x && uc[0].y < uc[1].y && uc[3].y < uc[2].y))
+    throw Error(what + ": frustum_corners are not in Unity's CalculateFrustumCorners order bottom-left, top-left, "
+                "top-right, bottom-right (got " + str(uc[0]) + ", " + str(uc[1]) + ", " + str(uc[2]) + ", " +
+                str(uc[3]) + "); corners already in fogcl's order go straight into CameraParams");
+  CameraParams p;
+  p.projection_params = u.projection_params;
+  p.frustum_corners = corners_from_unity_order(uc);
+  // Unity: reversed (far/near - 1, 1, ...), conventional (1 - far/near, far/near, ...), and
+  // far > near, so y == 1 exactly says reversed.
+  p.reversed_z = u.zbuffer_params.y == 1.0f;
+  p.projection = w == 1.0f ? Projection::orthographic : Projection::perspective;
+  if (p.projection == Projection::perspective) {
+    p.zbuffer_params = u.zbuffer_params;
+  } else {
+    // Unity computes _ZBufferParams from near and far as for a perspective camera; they carry the
+    // Z direction only. fogcl's orthographic variant takes its linear constants.
+    if (n > 0.0f) check_zbuffer_params(u.zbuffer_params, Projection::perspective, n, f, p.reversed_z, what);
+    p.zbuffer_params = zbuffer_params_for(Projection::orthographic, n, f, p.reversed_z);
+    for (const glm::vec3& corner : uc)
+      if (!close(std::fabs(corner.x), u.ortho_params.x, u.ortho_params.x) ||
+          !close(std::fabs(corner.y), u.ortho_params.y, u.ortho_params.y))
+        throw Error(what + ": orthographic frustum corner " + str(corner) +
+                    " does not lie at unity_OrthoParams' half extents (+-" + str(u.ortho_params.x) + ", +-" +
+                    str(u.ortho_params.y) + ")");
+  }
+  validate(p);
+  return p;
 }
 }  // namespace fogcl

@@ -1,4 +1,4 @@
-// OpenEXR input and output (DESIGN.md §2: the display window is the frame; pixels keep their
+// OpenEXR input and output (docs/DESIGN.md §2: the display window is the frame; pixels keep their
 // display-window positions; row 0 is the top row).
 //
 // Reading follows OpenEXR's own examples (website/src/readGZ1.cpp): a FrameBuffer with one FLOAT

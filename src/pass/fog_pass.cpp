@@ -1,9 +1,11 @@
 #include "fogcl/fog_pass.h"
 
 #include <cstring>
+#include <map>
 
 #include "deferred_fog_cl.h"
 #include "fogcl/error.h"
+#include "runtime/clhpp.h"
 #include "settings/fog_coefficients.h"
 
 namespace fogcl {
@@ -13,99 +15,192 @@ cl_float4 f4(float x, float y, float z, float w) { return cl_float4{{x, y, z, w}
 cl_float4 f4(const glm::vec4& v) { return f4(v.x, v.y, v.z, v.w); }
 cl_float4 f4(const glm::vec3& v) { return f4(v.x, v.y, v.z, 0.0f); }
 
-void check_buffer(const cl::Buffer& buffer, const char* name, std::size_t needed) {
-  if (buffer() == nullptr) throw Error(std::string("frame buffer ") + name + " is not set");
-  const std::size_t size = buffer.getInfo<CL_MEM_SIZE>();
-  if (size < needed)
-    throw Error(std::string("frame buffer ") + name + " holds " + std::to_string(size) +
-                " bytes but the frame needs " + std::to_string(needed));
+std::string frame_text(int width, int height, ColorFormat format) {
+  return std::to_string(width) + "x" + std::to_string(height) + " " + to_string(format);
+}
+
+// Exact size (docs/DESIGN.md §1.1): a larger buffer is legal OpenCL but, for a packed frame, means
+// a wrong format or size; `other_format_bytes` names the likely mistake.
+void check_buffer(cl_mem buffer, const char* name, const cl::Context& context, std::size_t needed,
+                  const std::string& frame, std::size_t other_format_bytes, ColorFormat other_format) {
+  if (buffer == nullptr) throw Error(std::string("frame buffer ") + name + " is not set (null cl_mem)");
+  const cl::Buffer b = wrap(buffer);
+  if (b.getInfo<CL_MEM_CONTEXT>()() != context())
+    throw Error(std::string("frame buffer ") + name + " belongs to another OpenCL context than the pass");
+  const std::size_t size = b.getInfo<CL_MEM_SIZE>();
+  if (size == needed) return;
+  std::string msg = std::string("frame buffer ") + name + " holds " + std::to_string(size) + " bytes but a " +
+                    frame + " frame needs exactly " + std::to_string(needed) +
+                    " (frames are packed and buffers exact-size; use a sub-buffer for part of a larger one)";
+  if (other_format_bytes != 0 && size == other_format_bytes)
+    msg += std::string(": that is the size of a ") + to_string(other_format) +
+           " frame, is FrameBuffers::format right?";
+  throw Error(msg);
 }
 }  // namespace
 
-FogPass::FogPass(cl::Context context, cl::Device device)
-    : device_(std::move(device)), programs_(std::move(context)) {
-  with_cl_errors([&] {
-    traits_.cpu = device_is_cpu(device_);
-    traits_.opencl_c_version = device_opencl_c_version(device_);
-  });
+std::size_t color_buffer_bytes(int width, int height, ColorFormat format) {
+  return std::size_t(width) * std::size_t(height) * bytes_per_pixel(format);
 }
 
-FogPass::FogPass(const Runtime& runtime, const CpuCodegen& codegen)
-    : FogPass(runtime.context(), runtime.device()) {
-  queue_ = runtime.queue();
-  traits_.codegen = codegen;
+std::size_t depth_buffer_bytes(int width, int height) {
+  return std::size_t(width) * std::size_t(height) * sizeof(float);
 }
 
-cl::Kernel& FogPass::kernel_for(const Variant& variant) {
-  if (last_kernel_ != nullptr && variant == last_kernel_variant_) return *last_kernel_;
-  const std::string options = build_options(variant, traits_);
-  auto it = kernels_.find(options);
-  if (it == kernels_.end()) {
-    cl::Program program = programs_.get(device_, "deferred_fog.cl", deferred_fog_cl, options);
-    it = kernels_.emplace(options, with_cl_errors([&] { return cl::Kernel(program, "deferred_fog"); })).first;
+struct FogPass::Impl {
+  cl::Context context;
+  cl::Device device;
+  std::shared_ptr<ProgramCache> programs;
+  cl::CommandQueue queue;  // convenience queue; created on first apply() if not given
+  DeviceTraits traits;
+  std::map<std::string, cl::Kernel> kernels;  // by build options
+  // The kernel of the most recent variant: a steady stream of frames skips the option string.
+  Variant last_kernel_variant;
+  cl::Kernel* last_kernel = nullptr;
+  PassStats stats;
+  Variant last_variant;
+
+  cl::Kernel* find_kernel(const Variant& variant);
+};
+
+FogPass::FogPass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs,
+                 const CpuCodegen& codegen)
+    : impl_(std::make_unique<Impl>()) {
+  if (context == nullptr || device == nullptr)
+    throw Error("FogPass needs a context and a device (got a null handle)");
+  Impl& m = *impl_;
+  m.context = wrap(context);
+  m.device = wrap(device);
+  if (programs == nullptr) programs = std::make_shared<ProgramCache>(context);
+  if (programs->context() != context)
+    throw Error("FogPass: the shared ProgramCache belongs to another OpenCL context than the pass");
+  m.programs = std::move(programs);
+  m.traits.codegen = codegen;
+  m.traits.cpu = device_is_cpu(device);
+  m.traits.opencl_c_version = device_opencl_c_version(device);
+}
+
+FogPass::FogPass(const Runtime& runtime, const CpuCodegen& codegen, std::shared_ptr<ProgramCache> programs)
+    : FogPass(runtime.context(), runtime.device(), std::move(programs), codegen) {
+  impl_->queue = wrap(runtime.queue());
+}
+
+FogPass::~FogPass() = default;
+FogPass::FogPass(FogPass&&) noexcept = default;
+FogPass& FogPass::operator=(FogPass&&) noexcept = default;
+
+std::string FogPass::build_options_for(const Variant& variant) const {
+  return build_options(variant, impl_->traits);
+}
+const PassStats& FogPass::stats() const { return impl_->stats; }
+const ProgramCache& FogPass::programs() const { return *impl_->programs; }
+const std::shared_ptr<ProgramCache>& FogPass::program_cache() const { return impl_->programs; }
+cl_context FogPass::context() const { return impl_->context(); }
+cl_device_id FogPass::device() const { return impl_->device(); }
+const Variant& FogPass::last_variant() const { return impl_->last_variant; }
+
+// The kernel of a built variant, or nullptr; creates the kernel object (no build) when another
+// pass sharing the cache built the program.
+cl::Kernel* FogPass::Impl::find_kernel(const Variant& variant) {
+  if (last_kernel != nullptr && variant == last_kernel_variant) return last_kernel;
+  const std::string options = build_options(variant, traits);
+  auto it = kernels.find(options);
+  if (it == kernels.end()) {
+    const cl_program program = programs->find(device(), "deferred_fog.cl", options);
+    if (program == nullptr) return nullptr;
+    it = kernels.emplace(options, with_cl_errors([&] { return cl::Kernel(wrap(program), "deferred_fog"); })).first;
   }
-  last_kernel_variant_ = variant;
-  last_kernel_ = &it->second;  // std::map nodes do not move
-  return it->second;
+  last_kernel_variant = variant;
+  last_kernel = &it->second;  // std::map nodes do not move
+  return last_kernel;
 }
 
 void FogPass::prepare(const Variant& variant) {
-  if (variant.needs_pass()) kernel_for(variant);
+  if (!variant.needs_pass() || impl_->find_kernel(variant) != nullptr) return;
+  impl_->programs->get(impl_->device(), "deferred_fog.cl", deferred_fog_cl, build_options_for(variant));
+  impl_->find_kernel(variant);
 }
 
-cl::Event FogPass::enqueue(const cl::CommandQueue& queue, const FrameBuffers& fb,
-                           const CameraParams& camera, const FogSettings& settings,
-                           const std::vector<cl::Event>& wait_list) {
+void FogPass::prepare(const FogSettings& settings, const CameraParams& camera, ColorFormat storage) {
+  validate(camera);
+  prepare(select_variant(settings, camera, storage));
+}
+
+bool FogPass::is_prepared(const Variant& variant) const {
+  if (!variant.needs_pass()) return true;
+  const std::string options = build_options_for(variant);
+  return impl_->kernels.count(options) != 0 ||
+         impl_->programs->find(impl_->device(), "deferred_fog.cl", options) != nullptr;
+}
+
+cl_event FogPass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
+                          const FogSettings& settings, const std::vector<cl_event>& wait_list) {
+  Impl& m = *impl_;
+  if (queue_handle == nullptr) throw Error("FogPass::enqueue: the queue is null");
   if (fb.width < 1 || fb.height < 1)
     throw Error("frame size must be at least 1x1 (got " + std::to_string(fb.width) + "x" +
                 std::to_string(fb.height) + ")");
   validate(camera);
   const Variant v = select_variant(settings, camera, fb.format);
-  const std::size_t pixels = std::size_t(fb.width) * std::size_t(fb.height);
-  const std::size_t color_bytes = pixels * bytes_per_pixel(fb.format);
+  const std::size_t color_bytes = color_buffer_bytes(fb.width, fb.height, fb.format);
   return with_cl_errors([&] {
-    check_buffer(fb.color_in, "color_in", color_bytes);
-    check_buffer(fb.depth, "depth", pixels * sizeof(float));
-    check_buffer(fb.color_out, "color_out", color_bytes);
-    const std::vector<cl::Event>* waits = wait_list.empty() ? nullptr : &wait_list;
+    const cl::CommandQueue queue = wrap(queue_handle);
+    if (queue.getInfo<CL_QUEUE_CONTEXT>()() != m.context())
+      throw Error("FogPass::enqueue: the queue belongs to another OpenCL context than the pass");
+    if (queue.getInfo<CL_QUEUE_DEVICE>()() != m.device())
+      throw Error("FogPass::enqueue: the queue is on another device than the pass (" +
+                  device_name(queue.getInfo<CL_QUEUE_DEVICE>()()) + ", pass: " + device_name(m.device()) + ")");
+    const std::string frame = frame_text(fb.width, fb.height, fb.format);
+    const ColorFormat other = fb.format == ColorFormat::rgba32f ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+    const std::size_t other_bytes = color_buffer_bytes(fb.width, fb.height, other);
+    check_buffer(fb.color_in, "color_in", m.context, color_bytes, frame, other_bytes, other);
+    check_buffer(fb.depth, "depth", m.context, depth_buffer_bytes(fb.width, fb.height), frame, 0, other);
+    check_buffer(fb.color_out, "color_out", m.context, color_bytes, frame, other_bytes, other);
+    cl::Kernel* kernel = v.needs_pass() ? m.find_kernel(v) : nullptr;
+    if (v.needs_pass() && kernel == nullptr)
+      throw Error("fog variant '" + describe(v) + "' is not prepared: call FogPass::prepare(settings, camera, " +
+                  to_string(fb.format) + ") (or prepare(variant)) before enqueue, which never builds a program");
+    std::vector<cl::Event> waits_storage;
+    for (cl_event e : wait_list) waits_storage.push_back(wrap(e));
+    const std::vector<cl::Event>* waits = waits_storage.empty() ? nullptr : &waits_storage;
     cl::Event done;
-    last_variant_ = v;
+    m.last_variant = v;
     if (!v.needs_pass()) {
-      if (fb.color_out() == fb.color_in()) {
+      if (fb.color_out == fb.color_in) {
         queue.enqueueMarkerWithWaitList(waits, &done);
       } else {
-        queue.enqueueCopyBuffer(fb.color_in, fb.color_out, 0, 0, color_bytes, waits, &done);
-        ++stats_.buffer_copies;
+        queue.enqueueCopyBuffer(wrap(fb.color_in), wrap(fb.color_out), 0, 0, color_bytes, waits, &done);
+        ++m.stats.buffer_copies;
       }
-      return done;
+      return share(done);
     }
     const detail::FogCoefficients<float> k = detail::fog_coefficients<float>(settings, v.mode);
-    cl::Kernel& kernel = kernel_for(v);
     const auto& c = camera.frustum_corners;
-    kernel.setArg(0, fb.color_in);
-    kernel.setArg(1, fb.depth);
-    kernel.setArg(2, fb.color_out);
-    kernel.setArg(3, cl_int(fb.width));
-    kernel.setArg(4, cl_int(fb.height));
-    kernel.setArg(5, f4(camera.zbuffer_params));
-    kernel.setArg(6, f4(camera.projection_params));
-    kernel.setArg(7, f4(c[kBottomLeft]));
-    kernel.setArg(8, f4(c[kBottomRight]));
-    kernel.setArg(9, f4(c[kTopLeft]));
-    kernel.setArg(10, f4(c[kTopRight]));
-    kernel.setArg(11, f4(k.a, k.b, 0.0f, 0.0f));
-    kernel.setArg(12, f4(settings.color.r, settings.color.g, settings.color.b, 0.0f));
-    const int per_item = pixels_per_work_item(traits_);
-    queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+    kernel->setArg(0, wrap(fb.color_in));
+    kernel->setArg(1, wrap(fb.depth));
+    kernel->setArg(2, wrap(fb.color_out));
+    kernel->setArg(3, cl_int(fb.width));
+    kernel->setArg(4, cl_int(fb.height));
+    kernel->setArg(5, f4(camera.zbuffer_params));
+    kernel->setArg(6, f4(camera.projection_params));
+    kernel->setArg(7, f4(c[kBottomLeft]));
+    kernel->setArg(8, f4(c[kBottomRight]));
+    kernel->setArg(9, f4(c[kTopLeft]));
+    kernel->setArg(10, f4(c[kTopRight]));
+    kernel->setArg(11, f4(k.a, k.b, 0.0f, 0.0f));
+    kernel->setArg(12, f4(settings.color.r, settings.color.g, settings.color.b, 0.0f));
+    const int per_item = pixels_per_work_item(m.traits);
+    queue.enqueueNDRangeKernel(*kernel, cl::NullRange,
                                cl::NDRange((fb.width + per_item - 1) / per_item, fb.height),
                                cl::NullRange, waits, &done);
-    ++stats_.kernel_dispatches;
-    return done;
+    ++m.stats.kernel_dispatches;
+    return share(done);
   });
 }
 
 void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                     const CameraParams& camera, const FogSettings& settings) {
+  Impl& m = *impl_;
   validate_frame(in, depth);
   validate(camera);
   const Variant v = select_variant(settings, camera, in.format());
@@ -113,42 +208,46 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
   if (!in_place && (out.width() != in.width() || out.height() != in.height() || out.format() != in.format()))
     out = ColorImage(in.width(), in.height(), in.format());
   if (!v.needs_pass()) {  // no device work at all
-    last_variant_ = v;
+    m.last_variant = v;
     if (!in_place) std::memcpy(out.data(), in.data(), in.size_bytes());
     return;
   }
+  prepare(v);  // apply blocks anyway: the one place that builds on demand
   with_cl_errors([&] {
-    if (queue_() == nullptr) queue_ = cl::CommandQueue(programs_.context(), device_, CL_QUEUE_PROFILING_ENABLE);
-    const cl::Context& ctx = programs_.context();
+    if (m.queue() == nullptr) m.queue = cl::CommandQueue(m.context, m.device, CL_QUEUE_PROFILING_ENABLE);
+    const cl::Context& ctx = m.context;
     // CPU devices read and write the host images where they are (page-aligned storage);
     // other devices get copies.
-    const cl_mem_flags host = traits_.cpu ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
+    const cl_mem_flags host = m.traits.cpu ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
     void* in_ptr = const_cast<void*>(in.data());
+    const cl::Buffer depth_buffer(ctx, CL_MEM_READ_ONLY | host, depth.size_bytes(), const_cast<float*>(depth.data()));
+    cl::Buffer color_in, color_out;
+    if (in_place) {
+      color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | host, in.size_bytes(), in_ptr);
+      color_out = color_in;
+    } else {
+      color_in = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, in.size_bytes(), in_ptr);
+      color_out = m.traits.cpu ? cl::Buffer(ctx, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out.size_bytes(), out.data())
+                               : cl::Buffer(ctx, CL_MEM_WRITE_ONLY, out.size_bytes());
+    }
     FrameBuffers fb;
     fb.width = in.width();
     fb.height = in.height();
     fb.format = in.format();
-    fb.depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, depth.size_bytes(), const_cast<float*>(depth.data()));
-    if (in_place) {
-      fb.color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | host, in.size_bytes(), in_ptr);
-      fb.color_out = fb.color_in;
-    } else {
-      fb.color_in = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, in.size_bytes(), in_ptr);
-      fb.color_out = traits_.cpu ? cl::Buffer(ctx, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out.size_bytes(), out.data())
-                                 : cl::Buffer(ctx, CL_MEM_WRITE_ONLY, out.size_bytes());
-    }
-    const cl::Event done = enqueue(queue_, fb, camera, settings);
-    const std::vector<cl::Event> after{done};
-    if (traits_.cpu) {
+    fb.color_in = color_in();
+    fb.depth = depth_buffer();
+    fb.color_out = color_out();
+    const std::vector<cl::Event> after{adopt(enqueue(m.queue(), fb, camera, settings))};
+    if (m.traits.cpu) {
       // Mapping is what makes a USE_HOST_PTR buffer's contents valid in host memory; on a CPU
       // device it returns the same pointer and copies nothing.
-      void* mapped = queue_.enqueueMapBuffer(fb.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes(), &after);
-      queue_.enqueueUnmapMemObject(fb.color_out, mapped);
-      queue_.finish();
-      ++stats_.zero_copy_frames;
+      void* mapped = m.queue.enqueueMapBuffer(color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes(), &after);
+      m.queue.enqueueUnmapMemObject(color_out, mapped);
+      m.queue.finish();
+      ++m.stats.zero_copy_frames;
     } else {
-      queue_.enqueueReadBuffer(fb.color_out, CL_TRUE, 0, out.size_bytes(), out.data(), &after);
-      ++stats_.copied_frames;
+      m.queue.enqueueReadBuffer(color_out, CL_TRUE, 0, out.size_bytes(), out.data(), &after);
+      ++m.stats.copied_frames;
     }
   });
 }

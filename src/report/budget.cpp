@@ -16,6 +16,7 @@
 
 #include "fogcl/error.h"
 #include "fogcl/report.h"
+#include "runtime/clhpp.h"
 
 namespace fogcl {
 
@@ -176,7 +177,7 @@ PrecisionChoice choose_precision_detailed(const Runtime& runtime, ColorFormat st
   if (!(max_error >= 0.0))
     throw Error("max error must be a number >= 0 (got " + num(max_error) + ")");
   const CacheKey key = with_cl_errors([&] {
-    const cl::Device& d = runtime.device();
+    const cl::Device d = wrap(runtime.device());
     const cl::Platform platform(d.getInfo<CL_DEVICE_PLATFORM>());
     return CacheKey{d.getInfo<CL_DEVICE_NAME>() + " (" + platform.getInfo<CL_PLATFORM_NAME>() + ")",
                     d.getInfo<CL_DRIVER_VERSION>(), library_version()};

@@ -1,5 +1,5 @@
 // fogcl report: error against run time for every precision variant and color storage on a set of
-// scenes (DESIGN.md §4). Device time comes from CL profiling events of FogPass::enqueue on
+// scenes (docs/DESIGN.md §4). Device time comes from CL profiling events of FogPass::enqueue on
 // zero-copy buffers, as bench/fog_bench.cpp's BM_OpenCLDevice measures it.
 #include "fogcl/report.h"
 
@@ -22,11 +22,12 @@
 #include "fogcl/fog_pass.h"
 #include "fogcl/scalar.h"
 #include "pass/formulas.h"
+#include "runtime/clhpp.h"
 #include "report_plot_py.h"  // generated from report/plot_report.py
 
 namespace fogcl {
 
-const char* library_version() { return FOGCL_VERSION; }
+// library_version(): src/runtime/version.cpp (fogcl/version.h).
 
 namespace {
 
@@ -144,34 +145,39 @@ double median(std::vector<double> v) {
 
 // The pass on the runtime's queue, zero-copy buffers over the images' memory on CPU devices
 // (copied buffers elsewhere). Returns the median device time [ms] of `runs` enqueues after one
-// untimed warm-up (which builds the variant); `out` holds the result.
+// untimed warm-up (after prepare() built the variant); `out` holds the result.
 double device_run(const Runtime& rt, FogPass& pass, const ColorImage& in, const DepthImage& depth,
                   ColorImage& out, const CameraParams& params, const FogSettings& s, int runs) {
   return with_cl_errors([&] {
     const bool cpu = rt.is_cpu();
     const cl_mem_flags host = cpu ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
+    const cl::Context ctx = wrap(rt.context());
+    const cl::CommandQueue queue = wrap(rt.queue());
     out = ColorImage(in.width(), in.height(), in.format());
+    const cl::Buffer color_in(ctx, CL_MEM_READ_ONLY | host, in.size_bytes(), const_cast<void*>(in.data()));
+    const cl::Buffer depth_buffer(ctx, CL_MEM_READ_ONLY | host, depth.size_bytes(), const_cast<float*>(depth.data()));
+    const cl::Buffer color_out(ctx, CL_MEM_READ_WRITE | host, out.size_bytes(), out.data());
     FrameBuffers fb;
     fb.width = in.width();
     fb.height = in.height();
     fb.format = in.format();
-    fb.color_in = cl::Buffer(rt.context(), CL_MEM_READ_ONLY | host, in.size_bytes(), const_cast<void*>(in.data()));
-    fb.depth = cl::Buffer(rt.context(), CL_MEM_READ_ONLY | host, depth.size_bytes(), const_cast<float*>(depth.data()));
-    fb.color_out = cl::Buffer(rt.context(), CL_MEM_READ_WRITE | host, out.size_bytes(), out.data());
-    pass.enqueue(rt.queue(), fb, params, s).wait();
+    fb.color_in = color_in();
+    fb.depth = depth_buffer();
+    fb.color_out = color_out();
+    pass.prepare(s, params, in.format());
+    adopt(pass.enqueue(rt.queue(), fb, params, s)).wait();
     std::vector<double> ms;
     for (int i = 0; i < runs; ++i) {
-      cl::Event e = pass.enqueue(rt.queue(), fb, params, s);
+      const cl::Event e = adopt(pass.enqueue(rt.queue(), fb, params, s));
       e.wait();
       ms.push_back(double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
                           e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6);
     }
     if (cpu)  // make the host view of the USE_HOST_PTR output valid (no copy on CPU devices)
-      rt.queue().enqueueUnmapMemObject(fb.color_out,
-                                       rt.queue().enqueueMapBuffer(fb.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes()));
+      queue.enqueueUnmapMemObject(color_out, queue.enqueueMapBuffer(color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes()));
     else
-      rt.queue().enqueueReadBuffer(fb.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
-    rt.queue().finish();
+      queue.enqueueReadBuffer(color_out, CL_TRUE, 0, out.size_bytes(), out.data());
+    queue.finish();
     return median(ms);
   });
 }
@@ -243,7 +249,7 @@ Report run_report(const Runtime* runtime, const ReportOptions& o) {
   report.height = o.height;
   report.runs = o.runs;
   report.device = runtime ? runtime->description() : "scalar";
-  if (runtime) report.driver = with_cl_errors([&] { return runtime->device().getInfo<CL_DRIVER_VERSION>(); });
+  if (runtime) report.driver = with_cl_errors([&] { return wrap(runtime->device()).getInfo<CL_DRIVER_VERSION>(); });
 
   std::unique_ptr<FogPass> pass;
   if (runtime) pass = std::make_unique<FogPass>(*runtime);

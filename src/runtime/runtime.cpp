@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <vector>
 
+#include "runtime/clhpp.h"
+
 namespace fogcl {
 
 namespace {
@@ -49,15 +51,19 @@ std::string resolve_device_choice(const std::string& explicit_choice) {
   return "cpu";
 }
 
-bool device_is_cpu(const cl::Device& device) {
-  return (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+bool device_is_cpu(cl_device_id device) {
+  return with_cl_errors([&] { return (wrap(device).getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0; });
 }
 
-std::string device_opencl_c_version(const cl::Device& device) {
-  return device.getInfo<CL_DEVICE_OPENCL_C_VERSION>();
+std::string device_opencl_c_version(cl_device_id device) {
+  return with_cl_errors([&] { return wrap(device).getInfo<CL_DEVICE_OPENCL_C_VERSION>(); });
 }
 
-cl::Device find_device(const std::string& choice) {
+std::string device_name(cl_device_id device) {
+  return with_cl_errors([&] { return wrap(device).getInfo<CL_DEVICE_NAME>(); });
+}
+
+cl_device_id find_device(const std::string& choice) {
   return with_cl_errors([&] {
     const std::vector<Candidate> all = all_devices();
     const std::string want = lower(choice);
@@ -83,31 +89,45 @@ cl::Device find_device(const std::string& choice) {
       throw Error("no OpenCL device matches '" + choice + "' (use cpu, gpu, scalar or part of a device name; available: " +
                   (list.empty() ? std::string("none") : list) + ")");
     }
-    return found->device;
+    return found->device();  // root devices are not reference counted: the handle outlives `all`
   });
 }
+
+struct Runtime::Handles {
+  cl::Context context;
+  cl::Device device;
+  cl::CommandQueue queue;
+};
 
 Runtime::Runtime(const std::string& choice) {
-  with_cl_errors([&] {
-    device_ = find_device(resolve_device_choice(choice));
-    context_ = cl::Context(device_);
-    queue_ = cl::CommandQueue(context_, device_, CL_QUEUE_PROFILING_ENABLE);
+  handles_ = with_cl_errors([&] {
+    auto h = std::make_shared<Handles>();
+    h->device = cl::Device(find_device(resolve_device_choice(choice)));
+    h->context = cl::Context(h->device);
+    h->queue = cl::CommandQueue(h->context, h->device, CL_QUEUE_PROFILING_ENABLE);
+    return h;
   });
 }
 
-Runtime::Runtime(cl::Context context, cl::Device device, cl::CommandQueue queue)
-    : context_(std::move(context)), device_(std::move(device)), queue_(std::move(queue)) {}
+Runtime::Runtime(cl_context context, cl_device_id device, cl_command_queue queue) {
+  if (context == nullptr || device == nullptr || queue == nullptr)
+    throw Error("Runtime needs a context, a device and a queue (one of them is null)");
+  handles_ = std::make_shared<Handles>(Handles{wrap(context), wrap(device), wrap(queue)});
+}
+
+cl_context Runtime::context() const { return handles_->context(); }
+cl_device_id Runtime::device() const { return handles_->device(); }
+cl_command_queue Runtime::queue() const { return handles_->queue(); }
 
 std::string Runtime::description() const {
   return with_cl_errors([&] {
-    const cl::Platform platform(device_.getInfo<CL_DEVICE_PLATFORM>());
-    return device_.getInfo<CL_DEVICE_NAME>() + " (" + platform.getInfo<CL_PLATFORM_NAME>() + ", " +
-           device_.getInfo<CL_DEVICE_VERSION>() + ")";
+    const cl::Device& device = handles_->device;
+    const cl::Platform platform(device.getInfo<CL_DEVICE_PLATFORM>());
+    return device.getInfo<CL_DEVICE_NAME>() + " (" + platform.getInfo<CL_PLATFORM_NAME>() + ", " +
+           device.getInfo<CL_DEVICE_VERSION>() + ")";
   });
 }
 
-bool Runtime::is_cpu() const {
-  return with_cl_errors([&] { return device_is_cpu(device_); });
-}
+bool Runtime::is_cpu() const { return device_is_cpu(device()); }
 
 }  // namespace fogcl

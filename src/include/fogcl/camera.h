@@ -1,4 +1,4 @@
-// Camera -> the constants a Unity shader sees (DESIGN.md §1, §2): _ZBufferParams,
+// Camera -> the constants a Unity shader sees (docs/DESIGN.md §1, §2): _ZBufferParams,
 // _ProjectionParams and the four far-plane frustum-corner rays.
 #pragma once
 
@@ -32,7 +32,7 @@ struct OrthographicCamera {
   bool reversed_z = false;         // depth 1 at near, 0 at far
 };
 
-// How raw depth maps to distance; each is its own kernel variant (DESIGN.md §2 last paragraph).
+// How raw depth maps to distance; each is its own kernel variant (docs/DESIGN.md §2.2).
 enum class Projection {
   perspective,               // Linear01Depth = 1 / (x * raw + y)
   perspective_infinite_far,  // reversed Z, far at infinity: eye depth = near / raw; raw 0 is sky
@@ -85,7 +85,38 @@ std::array<glm::vec3, 4> corners_from_unity_order(const std::array<glm::vec3, 4>
 }  // namespace fogcl
 
 namespace fogcl {
-// Checks constants handed in directly (integration API): finite, near > 0, far > near, and
-// _ZBufferParams consistent with a perspective depth (x * 1 + y > 0). Throws fogcl::Error.
+// Checks constants handed in directly (integration API) against each other, so that no
+// combination gives a silently unfogged or wrongly fogged frame (docs/DESIGN.md §2.1). Throws
+// fogcl::Error naming the value and the rule when
+//  - a value is not finite, near <= 0 (orthographic: < 0) or far <= near (far is +inf exactly
+//    for the infinite-far projection);
+//  - _ProjectionParams.x != 1 (-1 is Unity's flipped projection: flip the rows instead) or
+//    _ProjectionParams.w != 1 / far;
+//  - _ZBufferParams do not match near, far, `projection` and `reversed_z` (relative 1e-4): e.g.
+//    reversed-Z values (y = 1) with reversed_z = false, or conventional ones with reversed_z true;
+//  - the corners are not in fogcl's Corner order (left x < right x, bottom y < top y; Unity's
+//    order BL, TL, TR, BR fails this), not a rectangle, or not at the far plane (z = far;
+//    infinite far: z = 1).
 void validate(const CameraParams& params);
+
+// The constants as a Unity renderer has them, under Unity's names.
+struct UnityCameraConstants {
+  glm::vec4 zbuffer_params{0.0f};     // _ZBufferParams
+  glm::vec4 projection_params{0.0f};  // _ProjectionParams: (1, near, far, 1 / far)
+  // Camera.CalculateFrustumCorners(new Rect(0, 0, 1, 1), camera.farClipPlane, ...): view space,
+  // in Unity's order bottom-left, top-left, top-right, bottom-right, at z = far.
+  std::array<glm::vec3, 4> frustum_corners{};
+  // unity_OrthoParams: (half width = orthographicSize * aspect, half height = orthographicSize,
+  // unused, w = 1 orthographic / 0 perspective). All zero (the default) means perspective.
+  glm::vec4 ortho_params{0.0f};
+};
+
+// CameraParams from Unity's constants: the corners are reordered, reversed Z is read from
+// _ZBufferParams (y == 1: reversed; y == far / near: conventional) and the projection from
+// unity_OrthoParams.w. For orthographic cameras, Unity's _ZBufferParams (computed from near and
+// far as for perspective) only give the Z direction; fogcl's linear ones are derived, and the
+// corners must span unity_OrthoParams' half extents. The result is validated as above; every
+// inconsistency throws fogcl::Error naming the value and the rule. Unity has no infinite far
+// plane: use make_camera_params on a PerspectiveCamera with infinite_far for that variant.
+CameraParams camera_params_from_unity(const UnityCameraConstants& unity);
 }  // namespace fogcl

@@ -13,7 +13,7 @@
 //   ambient (0.22, 0.25, 0.3);
 // - sky: a vertical gradient from (0.85, 0.93, 1.1) at the horizon to (0.3, 0.5, 0.9) at the
 //   zenith; it is also what pixels show where the ground lies beyond the far plane.
-// One ray per pixel centre, in double, no anti-aliasing: pixel (x, y) takes the ray of DESIGN.md
+// One ray per pixel centre, in double, no anti-aliasing: pixel (x, y) takes the ray of docs/DESIGN.md
 // §2 (u = (x + 0.5) / W, v = 1 - (y + 0.5) / H, bilinear in the frustum corners) rotated into the
 // world by the DemoView basis; its depth is the raw device depth of the hit for the camera
 // (Linear01Depth(raw) = z_eye / far with the float _ZBufferParams), sky depth 1 (conventional Z)

@@ -1,5 +1,5 @@
 // What renderers write as depth, turned into the raw device depth the fog pass reads
-// (DESIGN.md §2). OpenEXR's Z is "distance from the viewer"; renderers write it as linear eye
+// (docs/DESIGN.md §2). OpenEXR's Z is "distance from the viewer"; renderers write it as linear eye
 // depth (along the view axis) or as radial distance from the eye.
 #pragma once
 

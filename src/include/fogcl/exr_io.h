@@ -1,4 +1,4 @@
-// OpenEXR input and output for the fog pass (DESIGN.md §2: the display window is the frame).
+// OpenEXR input and output for the fog pass (docs/DESIGN.md §2: the display window is the frame).
 #pragma once
 
 #include <cstddef>

@@ -17,7 +17,7 @@ enum class FogMetric {
   distance,  // d = |ray(u, v)| * Linear01Depth (radial distance from the eye)
 };
 
-// Precision of the kernel maths (DESIGN.md §4). The scalar path ignores it.
+// Precision of the kernel maths (docs/DESIGN.md §4). The scalar path ignores it.
 enum class Precision {
   precise,  // OpenCL default maths (built-ins within their spec ulp bounds); the default
   fast,     // -cl-fast-relaxed-math and native_ built-ins

@@ -3,7 +3,7 @@
 
 #include "fogcl/camera.h"
 #include "fogcl/error.h"
-#include "fogcl/cl.h"
+#include "fogcl/opencl_types.h"
 #include "fogcl/fog_pass.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
@@ -11,3 +11,4 @@
 #include "fogcl/runtime.h"
 #include "fogcl/scalar.h"
 #include "fogcl/variant.h"
+#include "fogcl/version.h"

@@ -1,4 +1,4 @@
-// Host images: the frame a renderer hands over (DESIGN.md §1, §2). Rows are stored top row
+// Host images: the frame a renderer hands over (docs/DESIGN.md §1, §2). Rows are stored top row
 // first; storage is page-aligned so OpenCL CPU devices can use it in place (CL_MEM_USE_HOST_PTR).
 #pragma once
 
@@ -41,6 +41,7 @@ class AlignedBytes {
 }  // namespace detail
 
 // Linear RGBA color, row-major, row 0 = top. Alpha is carried, never modified by the fog pass.
+// Threads: a value type; concurrent reads are fine, a write needs the only reference.
 class ColorImage {
  public:
   ColorImage() = default;
@@ -72,7 +73,8 @@ class ColorImage {
   detail::AlignedBytes bytes_;
 };
 
-// Raw device depth as a depth buffer stores it: float32 in [0, 1] (DESIGN.md §2).
+// Raw device depth as a depth buffer stores it: float32 in [0, 1] (docs/DESIGN.md §2).
+// Threads: as ColorImage.
 class DepthImage {
  public:
   DepthImage() = default;

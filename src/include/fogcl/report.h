@@ -1,4 +1,4 @@
-// Error against run time (DESIGN.md §4, issue 5): every precision variant x color storage on a set
+// Error against run time (docs/DESIGN.md §4, issue 5): every precision variant x color storage on a set
 // of scenes, each measured against the float64 path; and the error budget that picks the fastest
 // precision variant meeting a maximum error, measured once per device and library version.
 #pragma once
@@ -10,11 +10,10 @@
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
 #include "fogcl/runtime.h"
+#include "fogcl/version.h"  // library_version()
 
 namespace fogcl {
 
-// The library version (CMake's PROJECT_VERSION), e.g. "0.1.0".
-const char* library_version();
 
 struct ReportOptions {
   int width = 640;    // frame size of every scene [pixels], >= 1

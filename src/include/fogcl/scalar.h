@@ -1,6 +1,6 @@
 // The scalar C++ path: one thread, the formulas of kernels/fog_math.h instantiated on the float
 // type. float is the benchmark baseline and the no-OpenCL fallback; double is the reference every
-// other path's error is measured against (DESIGN.md §4).
+// other path's error is measured against (docs/DESIGN.md §4).
 #pragma once
 
 #include <vector>

@@ -1,4 +1,4 @@
-// The kernel variant a scene needs (DESIGN.md §3): every feature is a -D switch, and a feature
+// The kernel variant a scene needs (docs/DESIGN.md §3): every feature is a -D switch, and a feature
 // the scene does not use is not compiled at all. select_variant() and build_options() are the one
 // place where settings and camera become build options.
 #pragma once

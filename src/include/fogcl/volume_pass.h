@@ -5,96 +5,96 @@
 
 #include <cmath>
 #include <cstddef>
-#include <map>
 #include <memory>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "fogcl/camera.h"
-#include "fogcl/cl.h"
 #include "fogcl/fog_pass.h"
 #include "fogcl/image.h"
+#include "fogcl/opencl_types.h"
 #include "fogcl/runtime.h"
 #include "fogcl/volumes.h"
 
 namespace fogcl {
 
-// The main light's shadow map on the device (integration API).
+// The main light's shadow map on the device (integration API; the buffer is borrowed).
 struct ShadowMapBuffer {
-  cl::Buffer depth;  // width * height float32 raw depth of the light, row 0 = top
-  int width = 0;     // >= 1
-  int height = 0;    // >= 1
+  cl_mem depth = nullptr;  // exactly width * height float32: the light's raw depth, row 0 = top
+  int width = 0;           // >= 1
+  int height = 0;          // >= 1
   ShadowMapParams params;
 };
 
 struct VolumePassStats {
-  std::size_t march_dispatches = 0;      // march kernels enqueued
-  std::size_t composite_dispatches = 0;  // upsample + composite kernels enqueued
+  std::size_t march_dispatches = 0;        // march kernels enqueued
+  std::size_t composite_dispatches = 0;    // upsample + composite kernels enqueued
   std::size_t frames_without_volumes = 0;  // frames where nothing was visible: no dispatch
-  std::size_t noise_uploads = 0;         // noise textures uploaded to the device
-  std::size_t volumes_culled = 0;        // volumes left out by the host-side culling, all frames
+  std::size_t noise_uploads = 0;           // noise textures uploaded to the device
+  std::size_t volumes_culled = 0;          // volumes left out by the host-side culling, all frames
 };
 
 // The volumes of `scene` a frame can see, in the order given: each sphere is tested against the
-// camera's frustum (side planes, near and far) and against the depth buffer's range (a volume
-// wholly behind the farthest surface is hidden; max_eye_depth = +inf keeps every volume the
-// frustum keeps). Throws fogcl::Error for an invalid scene or camera.
+// camera's near and side planes and against the depth buffer's range (a volume wholly behind the
+// farthest surface is hidden; max_eye_depth = +inf keeps every volume the frustum keeps; there is
+// no far-plane test, sky pixels see infinitely far). Throws fogcl::Error for an invalid scene or
+// camera.
 std::vector<std::size_t> visible_volumes(const VolumeScene& scene, const CameraParams& camera,
                                          float max_eye_depth = INFINITY);
 
-// The farthest eye depth of a depth buffer, +inf when any pixel is sky (DESIGN §2's test).
+// The farthest eye depth of a depth buffer, +inf when any pixel is sky (docs/DESIGN.md §2's test).
 float max_eye_depth(const DepthImage& depth, const CameraParams& camera);
 
-// Not thread-safe: one VolumePass per thread. Keeps its noise textures on the device across frames.
+// Threads: a VolumePass is not thread-safe (kernel arguments, noise uploads): one per thread, or
+// lock around it. Passes may share one ProgramCache (thread-safe) with each other and with
+// FogPasses. It keeps its noise textures on the device across frames. Handles passed in are
+// borrowed for the call, except the context and device of the constructor, which it retains.
 class VolumePass {
  public:
-  // Integration: programs are built for `device` in the caller's `context`.
-  VolumePass(cl::Context context, cl::Device device);
+  // Integration: programs are built for `device` in the caller's `context`, in `programs` when
+  // given (a cache of the same context), else in a cache of its own.
+  VolumePass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs = nullptr);
   // Convenience: the runtime's context, device and queue.
-  explicit VolumePass(const Runtime& runtime);
+  explicit VolumePass(const Runtime& runtime, std::shared_ptr<ProgramCache> programs = nullptr);
+  ~VolumePass();
+  VolumePass(VolumePass&&) noexcept;
+  VolumePass& operator=(VolumePass&&) noexcept;
 
-  // Enqueues the march and the upsample + composite of `frame` on `queue` after `wait_list`
-  // and returns the event of the last command; never waits on the host. color_out may be
-  // color_in (in place). Nothing visible (culling with max_eye_depth, see visible_volumes): no
-  // kernel, a marker when in place, else one buffer copy — the output is the input bit for bit.
-  // The first frame of a noise texture uploads it (enqueued, not blocking). shadow may be null.
-  cl::Event enqueue(const cl::CommandQueue& queue, const FrameBuffers& frame, const CameraParams& camera,
-                    const VolumeScene& scene, const VolumeSettings& settings,
-                    const ShadowMapBuffer* shadow = nullptr, const std::vector<cl::Event>& wait_list = {},
-                    float max_eye_depth = INFINITY);
+  // Builds (or finds) the march and composite programs a frame of `scene` with `settings` needs:
+  // blocks for the builds (0.1-1 s each on PoCL). Call it at load time and when the variant
+  // changes (integrator, steps, features the visible volumes use, shadow map on/off, resolution,
+  // upsampling, storage, camera projection or Z direction). shadow: the shadow map's parameters
+  // when frames will have one (its Z direction is part of the variant), else null.
+  void prepare(const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
+               ColorFormat storage, const ShadowMapParams* shadow = nullptr);
 
-  // Convenience: host images in and out, blocks until `out` holds the result. out is reallocated
-  // unless it has in's size and format; out may be in. Culls with the depth image's range.
+  // Enqueues the march and the upsample + composite of `frame` on `queue` after `wait_list` and
+  // returns the event of the last command: a new reference the caller owns (clReleaseEvent).
+  // Never blocks and never builds (an unprepared variant throws fogcl::Error saying so). color_out
+  // may be color_in (in place). Nothing visible (culling with max_eye_depth, see visible_volumes):
+  // no kernel, a marker when in place, else one buffer copy — the output is the input bit for
+  // bit. A noise texture's first frame enqueues its upload. shadow may be null.
+  cl_event enqueue(cl_command_queue queue, const FrameBuffers& frame, const CameraParams& camera,
+                   const VolumeScene& scene, const VolumeSettings& settings,
+                   const ShadowMapBuffer* shadow = nullptr, const std::vector<cl_event>& wait_list = {},
+                   float max_eye_depth = INFINITY);
+
+  // Convenience: host images in and out; prepares what it needs and blocks until `out` holds the
+  // result. out is reallocated unless it has in's size and format; out may be in. Culls with the
+  // depth image's range: nothing visible touches no device.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
              const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow = nullptr);
 
-  // Builds (or finds) the programs `scene` and `settings` need on this pass's device, e.g. before
-  // the first frame (a first build takes 0.1-1 s on PoCL).
-  void prepare(const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
-               ColorFormat storage, bool with_shadow_map = false);
-
-  const VolumePassStats& stats() const { return stats_; }
-  const ProgramCache& programs() const { return programs_; }
+  const VolumePassStats& stats() const;
+  const ProgramCache& programs() const;
+  const std::shared_ptr<ProgramCache>& program_cache() const;
   // The march and composite build options of the most recent frame ("" when nothing ran).
-  const std::string& last_march_options() const { return last_march_options_; }
-  const std::string& last_composite_options() const { return last_composite_options_; }
+  const std::string& last_march_options() const;
+  const std::string& last_composite_options() const;
 
  private:
-  cl::Kernel& kernel(const std::string& source_name, const char* source, const char* kernel_name,
-                     const std::string& options);
-  const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
-                                    std::vector<cl::Event>& waits);
-
-  cl::Device device_;
-  ProgramCache programs_;
-  cl::CommandQueue queue_;  // convenience queue
-  DeviceTraits traits_;
-  bool images_ = false;     // the device supports images
-  std::map<std::string, cl::Kernel> kernels_;
-  std::map<std::tuple<int, unsigned, int>, std::pair<cl::Memory, cl::Event>> noise_;  // (size, seed, image)
-  VolumePassStats stats_;
-  std::string last_march_options_, last_composite_options_;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace fogcl
