@@ -20,6 +20,8 @@
 // or 0 (reversed Z).
 #pragma once
 
+#include <vector>
+
 #include <glm/vec3.hpp>
 
 #include "fogcl/camera.h"
@@ -67,5 +69,12 @@ struct DemoShadowRegion {
 // params' world_to_light_clip follows ShadowMapParams: clip xy in [-1, 1] -> the map's uv (v = 0
 // at the bottom row), clip z / w (w = 1) the stored depth. width, height >= 1.
 ShadowMap render_demo_shadow_map(int width = 1024, int height = 1024, const DemoShadowRegion& region = {});
+
+// The demo's four fog volumes, in this order: one around the default eye (the camera is inside),
+// one behind the (2.2, 1, -0.5) sphere, one crossing the ground, a wide bank around the far
+// spheres. Noise tiling 0.1-0.25 per world unit (a few billows per volume in this ~50-unit scene),
+// fades of a few units. For the physical integrator the densities become sigma_t = 0.15 x the
+// stylized alpha scale, with a sky-coloured ambient and mild forward scattering (g = 0.2).
+std::vector<FogVolume> demo_fog_volumes(VolumeIntegrator integrator);
 
 }  // namespace fogcl
