@@ -2,7 +2,8 @@
 //  - the renderer owns the context, the queue and the frame's buffers, and configures CLHPP its
 //    own way (here: OpenCL 3.0 target, exceptions off; see CMakeLists.txt);
 //  - its own kernel renders color (RGBA16F) and raw depth into those buffers;
-//  - fogcl's deferred fog runs in place on them, chained by events: no host round trip;
+//  - fogcl's fog volumes and then its deferred fog run in place on them, chained by events, the
+//    two passes sharing one program cache: no host round trip;
 //  - one read-back at the end.
 // Then, as a check (not part of the pattern), the same frame goes through fogcl's convenience API
 // (host images) and the two results must be equal bit for bit. Exit status 0 when they are.
@@ -11,6 +12,7 @@
 #include <CL/opencl.hpp>
 #include <fogcl/fogcl.h>
 #include <fogcl/version.h>
+#include <fogcl/volume_pass.h>
 
 #include <array>
 #include <cmath>
@@ -78,6 +80,30 @@ fogcl::UnityCameraConstants unity_camera(int width, int height) {
 
 cl_float4 f4(const glm::vec3& v) { return cl_float4{{v.x, v.y, v.z, 0.0f}}; }
 
+// Fog volumes in the renderer's world, which is its view space here (camera at the origin looking
+// along +z): a noisy bank around the red sphere and a thin haze over the ground.
+fogcl::VolumeScene fog_volumes() {
+  fogcl::VolumeScene scene;  // pose: eye (0, 0, 0), forward +z, up +y
+  scene.light.direction = {0.4f, 0.8f, -0.45f};
+  fogcl::FogVolume bank;
+  bank.center = {-1.0f, 0.5f, 10.0f};
+  bank.radius = 4.0f;
+  bank.density = 3.0f;
+  bank.fade_edge = 1.5f;
+  bank.proximity_fade = 0.0f;
+  bank.tiling = glm::vec3(0.2f);
+  bank.detail_tiling = glm::vec3(0.6f);
+  bank.fog_color = {0.85f, 0.9f, 1.0f, 1.0f};
+  fogcl::FogVolume haze = bank;
+  haze.center = {3.0f, -2.5f, 25.0f};
+  haze.radius = 9.0f;
+  haze.max_y = 0.0f;
+  haze.fade_y = 1.5f;
+  haze.density = 1.5f;
+  scene.volumes = {bank, haze};
+  return scene;
+}
+
 // The renderer's scene pass: enqueued, returns its event (no wait).
 bool render_scene(cl::CommandQueue& queue, cl::Kernel& kernel, const cl::Buffer& color, const cl::Buffer& depth,
                   int width, int height, const fogcl::CameraParams& camera, cl::Event* done) {
@@ -126,13 +152,17 @@ int main(int argc, char** argv) try {
   settings.density = 0.02f;
   settings.color = {0.6f, 0.65f, 0.7f};
   settings.metric = fogcl::FogMetric::distance;
+  const fogcl::VolumeScene volumes = fog_volumes();
+  const fogcl::VolumeSettings volume_settings;  // stylized, 50 steps, half resolution
 
   // [integration-core]
-  // Load time: one pass per device, programs built now (enqueue never builds).
+  // Load time: the passes share one program cache; programs are built now (enqueue never builds).
   fogcl::FogPass fog(context(), device());
+  fogcl::VolumePass volume_pass(context(), device(), fog.program_cache());
   fog.prepare(settings, camera, fogcl::ColorFormat::rgba16f);
+  volume_pass.prepare(camera, volumes, volume_settings, fogcl::ColorFormat::rgba16f);
 
-  // Each frame: the scene writes color + depth, fog runs in place after it, one read-back.
+  // Each frame: the scene writes color + depth; the volumes, then the fog, run in place after it.
   cl::Event scene_done;
   if (!render_scene(queue, scene_kernel, color, depth, width, height, camera, &scene_done)) return 1;
   fogcl::FrameBuffers frame;
@@ -141,11 +171,12 @@ int main(int argc, char** argv) try {
   frame.width = width;
   frame.height = height;
   frame.format = fogcl::ColorFormat::rgba16f;
-  cl_event last = fog.enqueue(queue(), frame, camera, settings, {scene_done()});
-  // Further passes (a volumetric one) chain the same way: wait on `last`, release it, keep theirs.
+  cl_event volumes_done = volume_pass.enqueue(queue(), frame, camera, volumes, volume_settings, nullptr, {scene_done()});
+  cl_event last = fog.enqueue(queue(), frame, camera, settings, {volumes_done});
+  clReleaseEvent(volumes_done);  // each enqueue's event is ours to release
   std::vector<std::uint16_t> result(4 * pixels);
   err = clEnqueueReadBuffer(queue(), color(), CL_TRUE, 0, result.size() * 2, result.data(), 1, &last, nullptr);
-  clReleaseEvent(last);  // enqueue's event is ours to release
+  clReleaseEvent(last);
   // [integration-core-end]
   if (!ok(err, "clEnqueueReadBuffer")) return 1;
 
@@ -160,8 +191,9 @@ int main(int argc, char** argv) try {
       !ok(queue.enqueueReadBuffer(depth2, CL_TRUE, 0, depth_image.size_bytes(), depth_image.data()), "read depth"))
     return 1;
   const fogcl::ColorImage unfogged = image;
-  fogcl::FogPass convenience(fogcl::Runtime(context(), device(), queue()));
-  convenience.apply(image, depth_image, image, camera, settings);
+  const fogcl::Runtime runtime(context(), device(), queue());
+  fogcl::VolumePass(runtime).apply(image, depth_image, image, camera, volumes, volume_settings);
+  fogcl::FogPass(runtime).apply(image, depth_image, image, camera, settings);
 
   fogcl::ColorImage integrated(width, height, fogcl::ColorFormat::rgba16f);
   std::memcpy(integrated.data(), result.data(), integrated.size_bytes());
@@ -178,7 +210,7 @@ int main(int argc, char** argv) try {
       }
     }
   std::printf("device: %s\n", fogcl::Runtime(context(), device(), queue()).description().c_str());
-  std::printf("fog changed %zu of %zu half values (the scene is fogged)\n", fogged, 4 * pixels);
+  std::printf("fog volumes + fog changed %zu of %zu half values (the scene is fogged)\n", fogged, 4 * pixels);
   std::printf("integration vs convenience API: max |difference| = %g, %zu of %zu half values differ\n", worst, differ,
               4 * pixels);
   if (fogged == 0) {
