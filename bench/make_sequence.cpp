@@ -68,9 +68,12 @@ int main(int argc, char** argv) {
       for (const char* c : rgba) color_header.channels().insert(c, Imf::Channel(type));
       Imf::OutputFile color(frame_name(dir, "color", frame).c_str(), color_header);
       Imf::FrameBuffer fb;
-      const float* pixels = f.color.rgba32f();
-      for (int c = 0; c < 4; ++c)  // OpenEXR converts float to half (round to nearest even)
-        fb.insert(rgba[c], Imf::Slice(Imf::FLOAT, (char*)(pixels + c), 16, 16 * std::size_t(width)));
+      // An OpenEXR writer does not convert: half channels from an rgba16f copy (round to nearest even).
+      const fogcl::ColorImage color_half = half ? fogcl::convert(f.color, fogcl::ColorFormat::rgba16f) : fogcl::ColorImage();
+      const char* pixels = static_cast<const char*>(half ? color_half.data() : f.color.data());
+      const std::size_t size = half ? 2 : 4;
+      for (int c = 0; c < 4; ++c)
+        fb.insert(rgba[c], Imf::Slice(type, const_cast<char*>(pixels + c * size), 4 * size, 4 * size * std::size_t(width)));
       color.setFrameBuffer(fb);
       color.writePixels(height);
 

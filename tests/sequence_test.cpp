@@ -212,22 +212,53 @@ std::vector<char> file_bytes(const std::string& p) {
 
 TEST_F(Sequence, ThreadCountsAndThePipelineChangeNoByte) {
   make_frames(5, 64, 36);
-  const std::string device = runtime() != nullptr ? "cpu" : "scalar";
-  CliRun r = run_cli(inputs() + " --out " + path("out/one.####.exr") + " --threads 1 --device " + device);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = run_cli(inputs() + " --out " + path("out/three.####.exr") + " --threads 3 --device " + device);
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  for (int f = 1; f <= 5; ++f) {
-    // The same frame fogged on its own, outside any pipeline.
-    const std::string single = path("out/single." + std::to_string(f) + ".exr");
-    r = run_cli("apply --color " + path("in/" + frame_name("color", f)) + " --depth " +
-                path("in/" + frame_name("depth", f)) + kFog + " --out " + single + " --device " + device);
+  std::vector<std::string> devices{"scalar"};  // --threads 3: the scalar pass runs in row bands
+  if (runtime() != nullptr) devices.push_back("cpu");
+  for (const std::string& device : devices) {
+    const std::string fog = std::string(kFog) + " --distance --device " + device;
+    CliRun r = run_cli(inputs() + " --distance --out " + path("out/one.####.exr") + " --threads 1 --device " + device);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    const std::vector<char> one = file_bytes(path("out/" + frame_name("one", f)));
-    EXPECT_FALSE(one.empty());
-    EXPECT_EQ(one, file_bytes(path("out/" + frame_name("three", f)))) << "frame " << f;
-    EXPECT_EQ(one, file_bytes(single)) << "frame " << f;
+    r = run_cli(inputs() + " --distance --out " + path("out/three.####.exr") + " --threads 3 --device " + device);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (int f = 1; f <= 5; ++f) {
+      // The same frame fogged on its own, outside any pipeline.
+      const std::string single = path("out/single." + std::to_string(f) + ".exr");
+      r = run_cli("apply --color " + path("in/" + frame_name("color", f)) + " --depth " +
+                  path("in/" + frame_name("depth", f)) + fog + " --threads 1 --out " + single);
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      const std::vector<char> one = file_bytes(path("out/" + frame_name("one", f)));
+      EXPECT_FALSE(one.empty());
+      EXPECT_EQ(one, file_bytes(path("out/" + frame_name("three", f)))) << device << " frame " << f;
+      EXPECT_EQ(one, file_bytes(single)) << device << " frame " << f;
+    }
   }
+}
+
+// The pieces the CLI runs on its threads give the bits of one call (float and half storage,
+// distance-based: the rays depend on the row).
+TEST(ScalarRows, BandsGiveTheBitsOfOneCall) {
+  for (const ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
+    const TestFrame t = make_test_frame(37, 29, false, format, 7);
+    FogSettings s;
+    s.mode = FogMode::exp2;
+    s.density = 0.01f;
+    s.metric = FogMetric::distance;
+    ColorImage whole, bands(t.color.width(), t.color.height(), format);
+    apply_fog_scalar(t.color, t.depth, whole, t.params, s);
+    for (int y = 0; y < t.color.height();) {
+      const int end = std::min(t.color.height(), y + 1 + y % 5);
+      apply_fog_scalar_rows(t.color, t.depth, bands, t.params, s, y, end);
+      y = end;
+    }
+    EXPECT_EQ(std::memcmp(whole.data(), bands.data(), whole.size_bytes()), 0) << to_string(format);
+  }
+  const TestFrame t = make_test_frame(8, 8, false, ColorFormat::rgba32f);
+  ColorImage small(4, 4);
+  EXPECT_MSG_HAS(error_of([&] { apply_fog_scalar_rows(t.color, t.depth, small, t.params, FogSettings{}, 0, 4); }),
+                 "must have the input's size and format");
+  ColorImage out(8, 8);
+  EXPECT_MSG_HAS(error_of([&] { apply_fog_scalar_rows(t.color, t.depth, out, t.params, FogSettings{}, 6, 9); }),
+                 "rows [6, 9) are not inside [0, 8)");
 }
 
 // Half in, half out: every pixel with f == 1 (sky, unfogged) keeps its 16 bits, NaN payloads,

@@ -12,6 +12,7 @@
 #include <exception>
 #include <filesystem>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -171,8 +172,29 @@ void read_frame(const ApplyOptions& o, FrameJob& job) {
   to_raw_depth(job.depth, kind, job.params);
 }
 
+// Output frames that were written, kept for the next frames: a fresh 33 MB (1080p float) frame
+// costs its page faults and zeroing every time.
+class SpareFrames {
+ public:
+  void give(ColorImage image) {
+    std::lock_guard<std::mutex> lock(m_);
+    if (spares_.size() < 2) spares_.push_back(std::move(image));
+  }
+  ColorImage take() {
+    std::lock_guard<std::mutex> lock(m_);
+    if (spares_.empty()) return ColorImage();
+    ColorImage image = std::move(spares_.back());
+    spares_.pop_back();
+    return image;
+  }
+
+ private:
+  std::mutex m_;
+  std::vector<ColorImage> spares_;
+};
+
 // The passes of one frame (fog thread; the only user of the backend). job.frame is the frame
-// number, for passes that depend on it.
+// number, for passes that depend on it. job.out may hold a spare frame to fog into.
 void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool print_setup) {
   const ExrInput& color = job.color;
   const CameraParams& params = job.params;
@@ -331,11 +353,16 @@ int run_apply(const ApplyOptions& o) {
                  o.png_path.empty() ? "" : frame_path(png, f)};
     read_frame(o, job);
   };
+  SpareFrames spares;
   stages.fog = [&](FrameJob& job) {
+    job.out = spares.take();  // the passes reuse it when it has the frame's size and storage
     fog_frame(o, backend, job, o.verbose && !setup_printed);
     setup_printed = true;
   };
-  stages.write = [&](FrameJob& job) { write_frame(o, job); };
+  stages.write = [&](FrameJob& job) {
+    write_frame(o, job);
+    spares.give(std::move(job.out));
+  };
   stages.done = [&](const FrameJob& job) {
     if (!job.error.empty()) {
       progress.clear();

@@ -8,8 +8,9 @@
 
 namespace fogcl::cli {
 
-// The path chosen by --device / FOGCL_DEVICE: an OpenCL device, or "scalar" (the one-thread C++
-// path, also the fallback when a machine has no OpenCL).
+// The path chosen by --device / FOGCL_DEVICE: an OpenCL device, or "scalar" (the C++ path, also
+// the fallback when a machine has no OpenCL; run in row bands on OpenEXR's global thread pool when
+// it has more than one thread, i.e. in `fogcl apply` with --threads > 1).
 class Backend {
  public:
   // choice: "" (FOGCL_DEVICE or cpu), cpu, gpu, scalar or part of a device name.
