@@ -105,7 +105,7 @@ TEST_F(Cli, HelpDocumentsEveryFlag) {
   for (const char* flag : {"--color", "--depth", "--out", "--near", "--far", "--fov", "--aspect", "--reversed-z",
                            "--mode", "--start", "--end", "--density", "--fog-color", "--distance",
                            "--fog-skybox", "--device", "--layer", "--depth-channel", "--depth-kind", "--rgba-only",
-                           "--png", "--frames", "--keep-going"})
+                           "--png", "--frames", "--keep-going", "--threads", "--pixel-type", "--compression"})
     EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
   const CliRun d = run_cli("demo --help");
   for (const char* flag : {"--out", "--width", "--height", "--device"})

@@ -1,18 +1,32 @@
 // `fogcl apply`: fogs renderer EXR output, one file or a frame sequence, with one device setup
-// and one program build for the whole sequence.
+// and one program build for the whole sequence. A sequence runs through a bounded pipeline
+// (frame_pipeline.h): reading, fogging and writing of three consecutive frames overlap.
+#include <sched.h>
+#include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <limits>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
+#include <OpenEXR/ImfThreading.h>
+
 #include "cli/cli.h"
+#include "cli/frame_pipeline.h"
 #include "cli/sequence.h"
+#include "cli/volumes_cli.h"
 #include "fogcl/depth_kinds.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/report.h"
+#include "io/atomic_file.h"
 
 namespace fogcl::cli {
 
@@ -107,9 +121,21 @@ FogSettings pass_settings(const ApplyOptions& o, Backend& backend, ColorFormat s
   return s;
 }
 
-// volumes: null without --volumes; sequence_frame: the frame number, -1 for a single file.
-void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backend, bool print_setup,
-                 VolumeStage* volumes, int sequence_frame) {
+// One frame in flight through read -> fog -> write (frame_pipeline.h).
+struct FrameJob {
+  int frame = 0;       // the frame number (0 for a single file)
+  std::string error;   // what failed ("" = fine so far)
+  FramePaths paths;
+  ExrInput color;      // its pixels are released once fogged; the rest describes the output
+  DepthImage depth;    // raw device depth
+  CameraParams params;
+  std::string camera_text;
+  ColorImage out;      // the fogged frame
+};
+
+// Reads a frame's color and depth and derives its camera (reader thread).
+void read_frame(const ApplyOptions& o, FrameJob& job) {
+  const FramePaths& paths = job.paths;
   const DepthKind kind = parse_depth_kind(o.depth_kind);
   // Outside the depth's data window (and in empty deep pixels) there is nothing: background.
   // Raw depth gets the sky value; eye / distance depth gets +inf, which converts to it.
@@ -118,19 +144,20 @@ void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backen
   ExrReadRequest request;
   request.layer = o.layer;
   request.depth_outside = outside;
+  // Half output of half input: fog in half storage, so that f == 1 pixels keep their bits (§2).
+  request.keep_half = o.pixel_type == "half";
   if (paths.depth.empty()) request.depth_channel = o.depth_channel;
-  ExrInput color = read_exr(paths.color, request);
+  job.color = read_exr(paths.color, request);
+  const ExrInput& color = job.color;
 
-  std::string camera_text;
-  const CameraParams params = frame_params(o, color, &camera_text);
+  job.params = frame_params(o, color, &job.camera_text);
   validate(o.settings);
-  if (kind != DepthKind::raw && params.projection != Projection::perspective)
+  if (kind != DepthKind::raw && job.params.projection != Projection::perspective)
     throw Error(std::string("--depth-kind ") + to_string(kind) + " needs a perspective camera with a finite far "
                 "plane (give raw depth with --ortho-size or --infinite-far)");
 
-  DepthImage depth;
   if (paths.depth.empty()) {
-    depth = std::move(color.depth);
+    job.depth = std::move(job.color.depth);
   } else {
     ExrReadRequest depth_request;
     depth_request.read_color = false;
@@ -141,16 +168,46 @@ void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backen
     if (!(d.windows == color.windows))
       throw Error(paths.depth + ": data/display window differs from " + paths.color +
                   "'s: depth and color must cover the same pixels");
-    depth = std::move(d.depth);
+    job.depth = std::move(d.depth);
   }
-  to_raw_depth(depth, kind, params);
+  to_raw_depth(job.depth, kind, job.params);
+}
 
+// Output frames that were written, kept for the next frames: a fresh 33 MB (1080p float) frame
+// costs its page faults and zeroing every time.
+class SpareFrames {
+ public:
+  void give(ColorImage image) {
+    std::lock_guard<std::mutex> lock(m_);
+    if (spares_.size() < 2) spares_.push_back(std::move(image));
+  }
+  ColorImage take() {
+    std::lock_guard<std::mutex> lock(m_);
+    if (spares_.empty()) return ColorImage();
+    ColorImage image = std::move(spares_.back());
+    spares_.pop_back();
+    return image;
+  }
+
+ private:
+  std::mutex m_;
+  std::vector<ColorImage> spares_;
+};
+
+// The passes of one frame (fog thread; the only user of the backend and the volume stage).
+// job.frame is the frame number, for passes that depend on it (sequence_frame: -1 for a single
+// file). job.out may hold a spare frame to fog into. volumes: null without --volumes.
+void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool print_setup, VolumeStage* volumes,
+               int sequence_frame) {
+  const ExrInput& color = job.color;
+  const CameraParams& params = job.params;
   std::string precision_why;
   const FogSettings settings = pass_settings(o, backend, color.color.format(), &precision_why);
   if (print_setup) {
+    const DepthKind kind = parse_depth_kind(o.depth_kind);
     const Variant variant = select_variant(settings, params, color.color.format());
     std::fprintf(stderr, "device: %s\n", backend.name().c_str());
-    std::fprintf(stderr, "camera: %s\n", camera_text.c_str());
+    std::fprintf(stderr, "camera: %s\n", job.camera_text.c_str());
     std::fprintf(stderr, "depth: %s, channel %s%s\n", to_string(kind), o.depth_channel.c_str(),
                  color.deep ? " (deep color, flattened)" : "");
     std::fprintf(stderr, "%s", precision_why.c_str());
@@ -170,17 +227,69 @@ void apply_frame(const ApplyOptions& o, const FramePaths& paths, Backend& backen
       std::fprintf(stderr, "  why: no pass runs (fog off or density 0): the output is the input\n");
     if (!backend.is_scalar() && variant.needs_pass())
       std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
+    std::fprintf(stderr, "output: %s, compression %s\n", o.pixel_type.c_str(),
+                 o.compression.empty() ? (std::string(exr_compression_name(color.compression)) + " (the input's)").c_str()
+                                       : o.compression.c_str());
   }
-  ColorImage out;
-  const ColorImage* fog_in = &color.color;
-  ColorImage with_volumes;
-  if (volumes != nullptr) {  // DESIGN §5: the volumes first, the deferred fog on their result
-    volumes->apply(color.color, depth, with_volumes, params, sequence_frame, print_setup);
-    fog_in = &with_volumes;
+  if (volumes != nullptr) {  // docs/DESIGN.md §5: the volumes first, the deferred fog on their result
+    ColorImage with_volumes;
+    volumes->apply(color.color, job.depth, with_volumes, params, sequence_frame, print_setup);
+    backend.apply(with_volumes, job.depth, job.out, params, settings);
+  } else {
+    backend.apply(color.color, job.depth, job.out, params, settings);
   }
-  backend.apply(*fog_in, depth, out, params, settings);
-  write_exr_output(paths.out, out, color, o.rgba_only);
-  if (!paths.png.empty()) write_png_preview(paths.png, out);
+  job.color.color = ColorImage();  // the inputs' pixels are not needed any more: memory stays bounded
+  job.depth = DepthImage();
+}
+
+// Writes a fogged frame (and its preview) (writer thread).
+void write_frame(const ApplyOptions& o, FrameJob& job) {
+  ExrWriteOptions w;
+  w.half = o.pixel_type == "half";
+  w.compression = o.compression.empty() ? -1 : parse_exr_compression(o.compression);
+  write_exr_output(job.paths.out, job.out, job.color, o.rgba_only, w);
+  if (!job.paths.png.empty()) write_png_preview(job.paths.png, job.out);
+}
+
+// Set by SIGINT / SIGTERM during a sequence: stop after the write in progress.
+std::atomic<int> g_interrupt{0};
+extern "C" void on_interrupt(int signo) { g_interrupt.store(signo); }
+
+// The handlers reset themselves (SA_RESETHAND): a second Ctrl-C ends the process at once (a write
+// then in progress leaves nothing either: atomic_file.h).
+void catch_interrupts() {
+  struct sigaction action {};
+  action.sa_handler = on_interrupt;
+  action.sa_flags = SA_RESETHAND;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+// Every core this process may run on (taskset, cgroup cpusets), as --threads' default.
+int available_cores() {
+  cpu_set_t set;
+  if (sched_getaffinity(0, sizeof set, &set) == 0) return std::max(1, CPU_COUNT(&set));
+  return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// The temporaries that killed runs left next to this sequence's outputs (atomic_file.h): only
+// those of frame names of `pattern`.
+int sweep_stale_temporaries(const FramePattern& pattern) {
+  if (!pattern.is_sequence) return 0;
+  // "out/shot." + digits + ".exr": the folder, and the file name's stem before the digits.
+  const std::filesystem::path probe(pattern.prefix + "x");
+  const std::string dir = probe.parent_path().empty() ? std::string(".") : probe.parent_path().string();
+  std::string stem = probe.filename().string();
+  stem.pop_back();
+  const std::string& suffix = pattern.suffix;
+  return detail::remove_stale_temporaries(dir, [&](const std::string& target) {
+    if (target.size() <= stem.size() + suffix.size() || target.compare(0, stem.size(), stem) != 0 ||
+        target.compare(target.size() - suffix.size(), suffix.size(), suffix) != 0)
+      return false;
+    const std::string digits = target.substr(stem.size(), target.size() - stem.size() - suffix.size());
+    return std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+  });
 }
 
 }  // namespace
@@ -193,10 +302,22 @@ int run_apply(const ApplyOptions& o) {
     throw Error("--infinite-far is a perspective projection; it does not go with --ortho-size");
   if (o.max_error_given && o.precision_given)
     throw Error("give either --precision or --max-error (which picks the precision), not both");
+  if (o.pixel_type != "float" && o.pixel_type != "half")
+    throw Error("--pixel-type must be half or float (got '" + o.pixel_type + "')");
+  if (!o.compression.empty()) parse_exr_compression(o.compression);
+  if (o.threads < 0 || o.threads > 4096)
+    throw Error("--threads must be between 1 and 4096 (got " + std::to_string(o.threads) + ")");
   const FramePattern color = parse_frame_pattern(o.color_path);
   const FramePattern depth = parse_frame_pattern(o.depth_path);
   const FramePattern out = parse_frame_pattern(o.out_path);
   const FramePattern png = parse_frame_pattern(o.png_path);
+
+  // --threads N: OpenEXR's pool (de)compresses with N threads, and PoCL runs the pass on N unless
+  // told otherwise (it reads POCL_MAX_PTHREAD_COUNT when the device is created).
+  const int threads = o.threads == 0 ? available_cores() : o.threads;
+  Imf::setGlobalThreadCount(threads);
+  setenv("POCL_MAX_PTHREAD_COUNT", std::to_string(threads).c_str(), 0);
+
   if (!color.is_sequence) {
     for (const FramePattern* p : {&depth, &out, &png})
       if (p->is_sequence)
@@ -204,7 +325,11 @@ int run_apply(const ApplyOptions& o) {
     if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
     Backend backend(o.device);
     const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
-    apply_frame(o, {o.color_path, o.depth_path, o.out_path, o.png_path}, backend, o.verbose, volumes.get(), -1);
+    FrameJob job;
+    job.paths = {o.color_path, o.depth_path, o.out_path, o.png_path};
+    read_frame(o, job);
+    fog_frame(o, backend, job, o.verbose, volumes.get(), -1);
+    write_frame(o, job);
     return 0;
   }
 
@@ -215,25 +340,67 @@ int run_apply(const ApplyOptions& o) {
   const std::vector<int> frames = o.frames.empty() ? frames_on_disk(color) : parse_frame_range(o.frames);
   if (frames.empty()) throw Error("'" + o.color_path + "': no frames found (give --frames FIRST-LAST)");
 
+  const int swept = sweep_stale_temporaries(out) + (o.png_path.empty() ? 0 : sweep_stale_temporaries(png));
   Backend backend(o.device);  // one device, one context, one program cache for every frame
   const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
+  if (o.verbose) {
+    std::fprintf(stderr, "threads: %d (OpenEXR (de)compression%s)\n", threads,
+                 backend.is_scalar() ? "" : "; PoCL's POCL_MAX_PTHREAD_COUNT unless set");
+    const std::filesystem::path out_dir = std::filesystem::path(out.prefix + "x").parent_path();
+    std::fprintf(stderr, "temporary files: %s\n",
+                 detail::temporary_file_kind(out_dir.empty() ? "." : out_dir.string()).c_str());
+    if (swept > 0) std::fprintf(stderr, "removed %d stale temporary file(s) of killed runs\n", swept);
+  }
   ProgressBar progress(int(frames.size()), true);
   std::vector<std::string> failures;
-  int done = 0;
-  for (int frame : frames) {
-    const FramePaths paths{frame_path(color, frame), o.depth_path.empty() ? "" : frame_path(depth, frame),
-                           frame_path(out, frame), o.png_path.empty() ? "" : frame_path(png, frame)};
-    try {
-      apply_frame(o, paths, backend, o.verbose && done == 0 && failures.empty(), volumes.get(), frame);
-    } catch (const std::exception& e) {
+  std::string stop_error;
+  int written = 0, last_written = -1;
+  bool setup_printed = false;
+
+  FramePipeline<FrameJob>::Stages stages;
+  stages.read = [&](FrameJob& job) {
+    const int f = job.frame;
+    job.paths = {frame_path(color, f), o.depth_path.empty() ? "" : frame_path(depth, f), frame_path(out, f),
+                 o.png_path.empty() ? "" : frame_path(png, f)};
+    read_frame(o, job);
+  };
+  SpareFrames spares;
+  stages.fog = [&](FrameJob& job) {
+    job.out = spares.take();  // the passes reuse it when it has the frame's size and storage
+    fog_frame(o, backend, job, o.verbose && !setup_printed, volumes.get(), job.frame);
+    setup_printed = true;
+  };
+  stages.write = [&](FrameJob& job) {
+    write_frame(o, job);
+    spares.give(std::move(job.out));
+  };
+  stages.done = [&](const FrameJob& job) {
+    if (!job.error.empty()) {
       progress.clear();
-      if (!o.keep_going) throw Error("frame " + std::to_string(frame) + ": " + e.what());
-      std::fprintf(stderr, "fogcl: frame %d failed: %s\n", frame, e.what());
-      failures.push_back("frame " + std::to_string(frame) + ": " + e.what());
+      if (!o.keep_going) {
+        stop_error = "frame " + std::to_string(job.frame) + ": " + job.error;
+        return false;
+      }
+      std::fprintf(stderr, "fogcl: frame %d failed: %s\n", job.frame, job.error.c_str());
+      failures.push_back("frame " + std::to_string(job.frame) + ": " + job.error);
+    } else {
+      ++written;
+      last_written = job.frame;
     }
-    progress.update(++done);
-  }
+    progress.update(written + int(failures.size()));
+    return true;
+  };
+  g_interrupt = 0;
+  catch_interrupts();
+  const auto outcome = FramePipeline<FrameJob>::run(frames, stages, &g_interrupt);
+  if (!stop_error.empty()) throw Error(stop_error);
   progress.finish();
+  if (outcome.interrupted) {
+    progress.clear();
+    std::fprintf(stderr, "fogcl: interrupted: %d of %zu frames written%s; no partial file left\n", written,
+                 frames.size(), last_written >= 0 ? (" (the last: frame " + std::to_string(last_written) + ")").c_str() : "");
+    return 128 + g_interrupt.load();
+  }
   if (!failures.empty()) {
     std::fprintf(stderr, "fogcl: error: %zu of %zu frames failed:\n", failures.size(), frames.size());
     for (const std::string& f : failures) std::fprintf(stderr, "  %s\n", f.c_str());

@@ -9,8 +9,9 @@
 
 namespace fogcl::cli {
 
-// The path chosen by --device / FOGCL_DEVICE: an OpenCL device, or "scalar" (the one-thread C++
-// path, also the fallback when a machine has no OpenCL).
+// The path chosen by --device / FOGCL_DEVICE: an OpenCL device, or "scalar" (the C++ path, also
+// the fallback when a machine has no OpenCL; run in row bands on OpenEXR's global thread pool when
+// it has more than one thread, i.e. in `fogcl apply` with --threads > 1).
 class Backend {
  public:
   // choice: "" (FOGCL_DEVICE or cpu), cpu, gpu, scalar or part of a device name.
@@ -46,6 +47,9 @@ struct ApplyOptions {
   bool rgba_only = false;          // output only R, G, B, A (no other channels, parts, attributes)
   std::string frames;              // "FIRST-LAST" for sequences; "" = the frames on disk
   bool keep_going = false;         // sequences: continue past a bad frame
+  int threads = 0;                 // OpenEXR's (de)compression threads (and PoCL's); 0 = every core
+  std::string pixel_type = "float";  // of the fogged R, G, B, A: float | half
+  std::string compression;         // of the output's color part; "" = the input's
   bool reversed_z = false;
   float ortho_size = 0;            // > 0: orthographic camera (Unity's orthographicSize), no fov
   bool infinite_far = false;       // reversed Z with the far plane at infinity (implies reversed_z)

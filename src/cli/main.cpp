@@ -64,6 +64,16 @@ int main(int argc, char** argv) {
   apply_cmd->add_option("--frames", ap.frames, "Sequences: FIRST-LAST (default: the frames found on disk)");
   apply_cmd->add_flag("--keep-going", ap.keep_going,
                       "Sequences: continue past a bad frame, list the failures at the end (exit code still 1)");
+  apply_cmd->add_option("--threads", ap.threads,
+                        "Threads that compress and decompress EXR data (OpenEXR's pool) and run PoCL's "
+                        "device, 1 to 4096 (default: every core this process may use)");
+  apply_cmd->add_option("--pixel-type", ap.pixel_type,
+                        "Output R, G, B, A as float (default) or half; half input written as half keeps "
+                        "unfogged pixels bit for bit")
+      ->capture_default_str();
+  apply_cmd->add_option("--compression", ap.compression,
+                        "Output compression: none, rle, zips, zip, piz, pxr24, b44, dwaa or dwab (default: the "
+                        "input's; other parts of a multi-part file are copied as stored)");
   apply_cmd->add_option("--near", ap.near_plane, "Camera near plane [world units], > 0")->required();
   apply_cmd->add_option("--far", ap.far_plane,
                         "Camera far plane [world units], > near; required unless --infinite-far (then it "
@@ -130,6 +140,8 @@ int main(int argc, char** argv) {
     }
     ap.precision_given = apply_cmd->count("--precision") > 0;
     ap.max_error_given = apply_cmd->count("--max-error") > 0;
+    if (apply_cmd->count("--threads") > 0 && ap.threads < 1)
+      throw fogcl::Error("--threads must be between 1 and 4096 (got " + std::to_string(ap.threads) + ")");
     if (apply_cmd->count("--far") == 0 && !ap.infinite_far)
       throw fogcl::Error("--far is required (except with --infinite-far)");
     if (apply_cmd->count("--ortho-size") > 0 && !(ap.ortho_size > 0.0f && std::isfinite(ap.ortho_size)))

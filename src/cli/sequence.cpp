@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
@@ -108,15 +109,30 @@ std::vector<int> parse_frame_range(const std::string& text) {
 ProgressBar::ProgressBar(int total, bool enabled)
     : total_(total), enabled_(enabled && ::isatty(STDERR_FILENO) == 1), start_(std::chrono::steady_clock::now()) {}
 
+std::string progress_text(int done, int total, double first_done_s, double last_done_s) {
+  const int width = 30;
+  const int filled = total > 0 ? std::clamp(int(double(width) * done / total), 0, width) : width;
+  std::string bar(std::size_t(filled), '=');
+  bar.resize(std::size_t(width), ' ');
+  double rate = 0;
+  if (done >= 2 && last_done_s > first_done_s)
+    rate = (done - 1) / (last_done_s - first_done_s);
+  else if (done >= 1 && last_done_s > 0)
+    rate = done / last_done_s;
+  char buf[160];
+  int n = std::snprintf(buf, sizeof buf, "[%s] %d/%d frames  %.2f frames/s", bar.c_str(), done, total, rate);
+  if (rate > 0 && done < total) {
+    const long eta = std::lround((total - done) / rate);
+    std::snprintf(buf + n, sizeof buf - std::size_t(n), "  ETA %ld:%02ld", eta / 60, eta % 60);
+  }
+  return buf;
+}
+
 void ProgressBar::update(int done) {
   if (!enabled_) return;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  const int width = 30;
-  const int filled = total_ > 0 ? int(double(width) * done / total_) : width;
-  std::string bar(std::size_t(filled), '=');
-  bar.resize(std::size_t(width), ' ');
-  std::fprintf(stderr, "\r[%s] %d/%d frames  %.2f frames/s", bar.c_str(), done, total_,
-               seconds > 0 ? done / seconds : 0.0);
+  if (done >= 1 && first_done_s_ < 0) first_done_s_ = seconds;
+  std::fprintf(stderr, "\r%s\033[K", progress_text(done, total_, first_done_s_, seconds).c_str());
   std::fflush(stderr);
   drawn_ = true;
 }

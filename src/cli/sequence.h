@@ -25,7 +25,14 @@ std::vector<int> frames_on_disk(const FramePattern& pattern);
 // "12" or "1-48" (inclusive, first <= last, both >= 0); throws fogcl::Error naming the text.
 std::vector<int> parse_frame_range(const std::string& text);
 
-// A one-line progress bar with frames/s on stderr, drawn only when stderr is a terminal.
+// The text of the progress bar: "[=====     ] 12/48 frames  3.10 frames/s  ETA 0:12". With frames
+// in flight the first frame finishes after a whole pipeline's latency and the next ones one
+// throughput apart, so the rate is taken between finished frames: (done - 1) / (last - first), the
+// time of the first and the latest finish since the start [s]; with one frame done, done / last.
+// ETA = frames left / rate.
+std::string progress_text(int done, int total, double first_done_s, double last_done_s);
+
+// A one-line progress bar (progress_text) on stderr, drawn only when stderr is a terminal.
 class ProgressBar {
  public:
   ProgressBar(int total, bool enabled);
@@ -40,6 +47,7 @@ class ProgressBar {
   bool enabled_;
   bool drawn_ = false;
   std::chrono::steady_clock::time_point start_;
+  double first_done_s_ = -1;
 };
 
 }  // namespace fogcl::cli

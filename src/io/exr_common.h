@@ -6,8 +6,14 @@
 #include <new>
 #include <string>
 
+#include <cerrno>
+#include <cstring>
+#include <ostream>
+
+#include <Iex.h>
 #include <Imath/ImathBox.h>
 #include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfIO.h>
 
 #include "fogcl/error.h"
 #include "fogcl/exr_io.h"
@@ -51,6 +57,23 @@ inline bool inside(const Imath::Box2i& inner, const Imath::Box2i& outer) {
 
 // Size of an inclusive box along one axis, in 64 bits (max - min overflows int for huge boxes).
 inline std::int64_t extent(int min, int max) { return std::int64_t(max) - std::int64_t(min) + 1; }
+
+// OpenEXR's output stream over the std::ostream that write_file_atomically hands out (Imf's own
+// StdOFStream wants an std::ofstream, which cannot hold an unnamed O_TMPFILE file).
+class OStreamAdapter : public Imf::OStream {
+ public:
+  OStreamAdapter(std::ostream& out, const std::string& name) : Imf::OStream(name.c_str()), out_(out) {}
+  void write(const char c[], int n) override {
+    if (!out_.write(c, n)) throw Iex::IoExc(std::string("write failed: ") + std::strerror(errno != 0 ? errno : EIO));
+  }
+  std::uint64_t tellp() override { return std::uint64_t(std::streamoff(out_.tellp())); }
+  void seekp(std::uint64_t pos) override {
+    if (!out_.seekp(std::streamoff(pos))) throw Iex::IoExc(std::string("seek failed: ") + std::strerror(errno != 0 ? errno : EIO));
+  }
+
+ private:
+  std::ostream& out_;
+};
 
 // Runs `read` and turns whatever OpenEXR (Iex), the standard library or the allocator throws into
 // one fogcl::Error line naming the file. Our own fogcl::Errors already name it and pass through.

@@ -83,25 +83,54 @@ ExrWindows full_frame(int width, int height) {
   return w;
 }
 
-// Writes FLOAT channels `names` from interleaved float pixels (`stride` floats per pixel) of a
-// display-window-sized frame; only the data window's pixels go to the file.
-void write_float_exr(std::ofstream& out, const std::string& temp_path, const ExrWindows& w,
-                     const float* pixels, int width, const char* const* names, int channel_count) {
+Imf::PixelType pixel_type_of(ColorFormat f) { return f == ColorFormat::rgba16f ? Imf::HALF : Imf::FLOAT; }
+
+// `image` in half or float storage: itself, or converted into `converted` (half -> float is exact,
+// float -> half rounds to nearest even). OpenEXR writes a channel only from a slice of its own type.
+const ColorImage& in_format(const ColorImage& image, bool half, ColorImage& converted) {
+  const ColorFormat want = half ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+  return image.format() == want ? image : (converted = convert(image, want));
+}
+
+// Writes channels `names` from interleaved pixels (`channel_count` values of `memory_type` per
+// pixel) of a display-window-sized frame, as `file_type` (OpenEXR wants the same type: a writer
+// does not convert); only the data window's pixels go to the file.
+void write_exr_channels(std::ostream& out, const std::string& name, const ExrWindows& w, const char* pixels,
+                        Imf::PixelType memory_type, int width, const char* const* names, int channel_count,
+                        Imf::PixelType file_type, Imf::Compression compression) {
   const Imath::Box2i display = to_box(w.display_min, w.display_max);
   const Imath::Box2i data = to_box(w.data_min, w.data_max);
-  Imf::StdOFStream stream(out, temp_path.c_str());
+  detail::OStreamAdapter stream(out, name);
   Imf::Header header(display, data);
-  for (int c = 0; c < channel_count; ++c) header.channels().insert(names[c], Imf::Channel(Imf::FLOAT));
+  header.compression() = compression;
+  for (int c = 0; c < channel_count; ++c) header.channels().insert(names[c], Imf::Channel(file_type));
   Imf::OutputFile file(stream, header);
-  const std::size_t x_stride = std::size_t(channel_count) * sizeof(float);
+  const std::size_t value_size = memory_type == Imf::HALF ? 2 : 4;
+  const std::size_t x_stride = std::size_t(channel_count) * value_size;
   const std::size_t y_stride = x_stride * std::size_t(width);
   Imf::FrameBuffer frame_buffer;
   for (int c = 0; c < channel_count; ++c)
-    frame_buffer.insert(names[c], Imf::Slice::Make(Imf::FLOAT, pixels + c, display, x_stride, y_stride));
+    frame_buffer.insert(names[c],
+                        Imf::Slice::Make(memory_type, pixels + std::size_t(c) * value_size, display, x_stride, y_stride));
   file.setFrameBuffer(frame_buffer);
   file.writePixels(data.max.y - data.min.y + 1);
-  // ~OutputFile writes the line offset table but cannot report a failure; the caller checks the
-  // std::ofstream after closing it.
+  // ~OutputFile writes the line offset table but cannot report a failure; write_file_atomically
+  // checks the stream after the body returns.
+}
+
+void write_rgba(const std::string& path, const ColorImage& image, const ExrWindows* windows, bool half,
+                Imf::Compression compression) {
+  if (image.empty()) throw Error(path + ": cannot write EXR: the image is empty");
+  const ExrWindows w = windows != nullptr ? *windows : full_frame(image.width(), image.height());
+  check_windows(path, w, image.width(), image.height());
+  ColorImage converted;
+  const ColorImage& source = in_format(image, half, converted);
+  static const char* const names[4] = {"R", "G", "B", "A"};
+  const char* pixels = static_cast<const char*>(source.data());
+  const Imf::PixelType type = pixel_type_of(source.format());
+  detail::write_file_atomically(path, "EXR", [&](std::ostream& out, const std::string& name) {
+    write_exr_channels(out, name, w, pixels, type, source.width(), names, 4, type, compression);
+  });
 }
 
 }  // namespace
@@ -128,30 +157,29 @@ DepthImage read_exr_depth(const std::string& path, ExrWindows* windows, const st
 }
 
 void write_exr_rgba(const std::string& path, const ColorImage& image, const ExrWindows* windows) {
-  if (image.empty()) throw Error(path + ": cannot write EXR: the image is empty");
-  const ExrWindows w = windows != nullptr ? *windows : full_frame(image.width(), image.height());
-  check_windows(path, w, image.width(), image.height());
-  ColorImage converted;  // half images are widened to float (exact)
-  const ColorImage& source =
-      image.format() == ColorFormat::rgba32f ? image : (converted = convert(image, ColorFormat::rgba32f));
-  static const char* const names[4] = {"R", "G", "B", "A"};
-  detail::write_file_atomically(path, "EXR", [&](std::ofstream& out, const std::string& temp_path) {
-    write_float_exr(out, temp_path, w, source.rgba32f(), source.width(), names, 4);
-  });
+  write_rgba(path, image, windows, false, Imf::ZIP_COMPRESSION);  // half images are widened (exact)
 }
 
 void write_exr_depth(const std::string& path, const DepthImage& depth) {
   if (depth.empty()) throw Error(path + ": cannot write EXR: the depth image is empty");
   const ExrWindows w = full_frame(depth.width(), depth.height());
   static const char* const names[1] = {"Z"};
-  detail::write_file_atomically(path, "EXR", [&](std::ofstream& out, const std::string& temp_path) {
-    write_float_exr(out, temp_path, w, depth.data(), depth.width(), names, 1);
+  detail::write_file_atomically(path, "EXR", [&](std::ostream& out, const std::string& name) {
+    write_exr_channels(out, name, w, reinterpret_cast<const char*>(depth.data()), Imf::FLOAT, depth.width(), names, 1,
+                       Imf::FLOAT, Imf::ZIP_COMPRESSION);
   });
 }
 
 namespace {
 
 std::size_t pixel_type_size(Imf::PixelType t) { return t == Imf::HALF ? 2 : 4; }
+
+const struct {
+  const char* name;
+  Imf::Compression compression;
+} kCompressions[] = {{"none", Imf::NO_COMPRESSION}, {"rle", Imf::RLE_COMPRESSION},   {"zips", Imf::ZIPS_COMPRESSION},
+                     {"zip", Imf::ZIP_COMPRESSION},  {"piz", Imf::PIZ_COMPRESSION},   {"pxr24", Imf::PXR24_COMPRESSION},
+                     {"b44", Imf::B44_COMPRESSION},  {"dwaa", Imf::DWAA_COMPRESSION}, {"dwab", Imf::DWAB_COMPRESSION}};
 
 // A channel of the color part other than the fogged layer's R, G, B, A, kept in the output.
 struct KeptChannel {
@@ -163,16 +191,33 @@ struct KeptChannel {
 
 }  // namespace
 
-void write_exr_output(const std::string& path, const ColorImage& fogged, const ExrInput& source, bool rgba_only) {
+int parse_exr_compression(const std::string& name) {
+  for (const auto& c : kCompressions)
+    if (name == c.name) return int(c.compression);
+  std::string names;
+  for (const auto& c : kCompressions) names += std::string(names.empty() ? "" : ", ") + c.name;
+  throw Error("--compression must be one of " + names + " (got '" + name + "')");
+}
+
+const char* exr_compression_name(int compression) {
+  for (const auto& c : kCompressions)
+    if (int(c.compression) == compression) return c.name;
+  return "unknown";
+}
+
+void write_exr_output(const std::string& path, const ColorImage& fogged, const ExrInput& source, bool rgba_only,
+                      const ExrWriteOptions& options) {
   if (rgba_only || source.color_part < 0 || source.path.empty()) {
-    write_exr_rgba(path, fogged, &source.windows);
+    const int compression = options.compression >= 0 ? options.compression
+                            : source.compression >= 0 ? source.compression
+                                                      : int(Imf::ZIP_COMPRESSION);
+    write_rgba(path, fogged, &source.windows, options.half, Imf::Compression(compression));
     return;
   }
   if (fogged.empty()) throw Error(path + ": cannot write EXR: the image is empty");
   check_windows(path, source.windows, fogged.width(), fogged.height());
-  ColorImage converted;  // half images are widened to float (exact)
-  const ColorImage& image =
-      fogged.format() == ColorFormat::rgba32f ? fogged : (converted = convert(fogged, ColorFormat::rgba32f));
+  ColorImage converted;
+  const ColorImage& image = in_format(fogged, options.half, converted);
   const std::string prefix = source.layer.empty() ? "" : source.layer + ".";
   const std::string rgba[4] = {prefix + "R", prefix + "G", prefix + "B", prefix + "A"};
 
@@ -220,23 +265,27 @@ void write_exr_output(const std::string& path, const ColorImage& fogged, const E
     // The color part becomes a flat scanline part: the layer in FLOAT plus the kept channels.
     Imf::ChannelList channels;
     for (const KeptChannel& k : kept) channels.insert(k.name, k.channel);
-    for (const std::string& c : rgba) channels.insert(c, Imf::Channel(Imf::FLOAT));
+    for (const std::string& c : rgba) channels.insert(c, Imf::Channel(options.half ? Imf::HALF : Imf::FLOAT));
     h.channels() = channels;
+    if (options.compression >= 0) h.compression() = Imf::Compression(options.compression);
     for (const char* structural : {"tiles", "chunkCount", "version", "maxSamplesPerPixel"})
       if (h.find(structural) != h.end()) h.erase(structural);
     if (h.hasType()) h.setType(Imf::SCANLINEIMAGE);
     if (h.lineOrder() == Imf::RANDOM_Y) h.lineOrder() = Imf::INCREASING_Y;
 
-    detail::write_file_atomically(path, "EXR", [&](std::ofstream& out, const std::string& temp_path) {
-      Imf::StdOFStream ostream(out, temp_path.c_str());
+    detail::write_file_atomically(path, "EXR", [&](std::ostream& out, const std::string& name) {
+      detail::OStreamAdapter ostream(out, name);
       Imf::MultiPartOutputFile file(ostream, headers.data(), int(headers.size()));
       for (int p = 0; p < in.parts(); ++p) {
         if (p == source.color_part) {
           Imf::OutputPart part(file, p);
           Imf::FrameBuffer fb;
-          const std::size_t x_stride = 4 * sizeof(float), y_stride = x_stride * std::size_t(image.width());
+          const Imf::PixelType type = pixel_type_of(image.format());
+          const std::size_t value_size = type == Imf::HALF ? 2 : 4;
+          const std::size_t x_stride = 4 * value_size, y_stride = x_stride * std::size_t(image.width());
+          const char* pixels = static_cast<const char*>(image.data());
           for (int c = 0; c < 4; ++c)
-            fb.insert(rgba[c], Imf::Slice::Make(Imf::FLOAT, image.rgba32f() + c, display, x_stride, y_stride));
+            fb.insert(rgba[c], Imf::Slice::Make(type, pixels + std::size_t(c) * value_size, display, x_stride, y_stride));
           for (KeptChannel& k : kept) {
             const std::size_t size = pixel_type_size(k.channel.type);
             fb.insert(k.name, Imf::Slice::Make(k.channel.type, k.pixels.data(), data, size, size * k.row_samples,

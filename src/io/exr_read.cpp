@@ -143,15 +143,17 @@ Frame frame_of(const Source& s, int part, const ExrReadRequest& r, ExrWindows* w
   return f;
 }
 
-// Reads FLOAT slices (or fills) for `names` into a frame with `stride` floats per pixel.
-void read_flat(Source& s, int part, const Frame& f, float* frame, int stride,
+// Reads `type` slices (or fills) for `names` into a frame with `stride` values per pixel.
+void read_flat(Source& s, int part, const Frame& f, void* frame, Imf::PixelType type, int stride,
                const std::vector<std::string>& names, const std::vector<double>& fill) {
   Imf::InputPart in(*s.file, part);
-  const std::size_t x_stride = std::size_t(stride) * sizeof(float);
+  const std::size_t value_size = type == Imf::HALF ? 2 : 4;
+  const std::size_t x_stride = std::size_t(stride) * value_size;
   const std::size_t y_stride = x_stride * std::size_t(f.width);
   Imf::FrameBuffer fb;
   for (std::size_t c = 0; c < names.size(); ++c)
-    fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, frame + c, f.display, x_stride, y_stride, 1, 1, fill[c]));
+    fb.insert(names[c], Imf::Slice::Make(type, static_cast<char*>(frame) + c * value_size, f.display, x_stride,
+                                         y_stride, 1, 1, fill[c]));
   in.setFrameBuffer(fb);
   in.readPixels(f.data.min.y, f.data.max.y);
 }
@@ -362,9 +364,10 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
     if (is_deep(dh))
       read_deep(s, out.depth_part, df, r, prefix, nullptr, out.depth.data(), name);
     else
-      read_flat(s, out.depth_part, df, out.depth.data(), 1, {name}, {0.0});
+      read_flat(s, out.depth_part, df, out.depth.data(), Imf::FLOAT, 1, {name}, {0.0});
     if (!r.read_color) {
       out.windows = depth_windows;
+      out.compression = int(dh.compression());
       return out;
     }
   }
@@ -378,13 +381,18 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
                 "deep tiled parts are not supported (deep scanline parts are flattened)");
   const Frame f = frame_of(s, out.color_part, r, &out.windows);
   out.camera = camera_of(ch);
-  out.color = ColorImage(f.width, f.height, ColorFormat::rgba32f);  // starts (0, 0, 0, 0)
+  out.compression = int(ch.compression());
+  bool all_half = !is_deep(ch);
+  for (const char* c : {"R", "G", "B", "A"})
+    if (const Imf::Channel* channel = ch.channels().findChannel(prefix + c)) all_half = all_half && channel->type == Imf::HALF;
+  const bool half = r.keep_half && all_half;
+  out.color = ColorImage(f.width, f.height, half ? ColorFormat::rgba16f : ColorFormat::rgba32f);  // (0, 0, 0, 0)
   if (is_deep(ch)) {
     out.deep = true;
     read_deep(s, out.color_part, f, r, prefix, out.color.rgba32f(), nullptr, "Z");
   } else {
     // Only A can be missing here: opaque.
-    read_flat(s, out.color_part, f, out.color.rgba32f(), 4,
+    read_flat(s, out.color_part, f, out.color.data(), half ? Imf::HALF : Imf::FLOAT, 4,
               {prefix + "R", prefix + "G", prefix + "B", prefix + "A"}, {0.0, 0.0, 0.0, 1.0});
   }
   return out;

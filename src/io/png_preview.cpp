@@ -105,7 +105,7 @@ void write_png_preview(const std::string& path, const ColorImage& image) {
   }
   png_image_free(&png);
 
-  detail::write_file_atomically(path, "PNG", [&](std::ofstream& out, const std::string&) {
+  detail::write_file_atomically(path, "PNG", [&](std::ostream& out, const std::string&) {
     out.write(reinterpret_cast<const char*>(encoded.data()), std::streamsize(size));
   });
 }

@@ -6,6 +6,7 @@
 
 #include <Imath/half.h>
 
+#include "fogcl/error.h"
 #include "fogcl/variant.h"
 #include "pass/formulas.h"
 #include "settings/fog_coefficients.h"
@@ -46,7 +47,7 @@ float load_channel(const std::uint16_t* p) {
 // (alpha passed through), all in T.
 template <class T, class Channel, class Sink>
 FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParams& cam,
-                const Variant& v, const FogSettings& s, bool with_amount, Sink&& sink) {
+                const Variant& v, const FogSettings& s, bool with_amount, int y0, int y1, Sink&& sink) {
   using namespace detail;
   using namespace formulas;
   const int w = depth.width(), h = depth.height();
@@ -59,7 +60,7 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
   const int mode = int(v.mode), distance = v.distance, skybox = v.fog_skybox, reversed = v.reversed_z;
   const int projection = int(v.projection), squared = FOG_SQUARED(mode, distance);
   const T inv_width = T(1) / T(w);
-  for (int y = 0; y < h; ++y) {
+  for (int y = y0; y < y1; ++y) {
     const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
@@ -84,11 +85,11 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
 // Runs fog_pixels with the channel type of the image's storage.
 template <class T, class Sink>
 FOGCL_INLINE void fog_image(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
-               const Variant& v, const FogSettings& s, bool with_amount, Sink&& sink) {
+               const Variant& v, const FogSettings& s, bool with_amount, int y0, int y1, Sink&& sink) {
   if (in.format() == ColorFormat::rgba32f)
-    fog_pixels<T>(in.rgba32f(), depth, cam, v, s, with_amount, sink);
+    fog_pixels<T>(in.rgba32f(), depth, cam, v, s, with_amount, y0, y1, sink);
   else
-    fog_pixels<T>(in.rgba16f(), depth, cam, v, s, with_amount, sink);
+    fog_pixels<T>(in.rgba16f(), depth, cam, v, s, with_amount, y0, y1, sink);
 }
 
 Variant checked_variant(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
@@ -100,18 +101,18 @@ Variant checked_variant(const ColorImage& in, const DepthImage& depth, const Cam
 
 // The float path of apply_fog_scalar (see FOGCL_TARGET_CLONES).
 FOGCL_TARGET_CLONES void fog_into(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
-                                  const Variant& v, const FogSettings& s, ColorImage& out) {
+                                  const Variant& v, const FogSettings& s, ColorImage& out, int y0, int y1) {
   const std::size_t pixel_bytes = bytes_per_pixel(in.format());
   const auto* src = static_cast<const std::byte*>(in.data());
   auto* dst = static_cast<std::byte*>(out.data());
   if (in.format() == ColorFormat::rgba32f) {
     float* o = out.rgba32f();
-    fog_image<float>(in, depth, cam, v, s, false, [&](std::size_t i, float, float, const float* rgba) {
+    fog_image<float>(in, depth, cam, v, s, false, y0, y1, [&](std::size_t i, float, float, const float* rgba) {
       for (int c = 0; c < 4; ++c) o[4 * i + c] = rgba[c];
     });
   } else {
     std::uint16_t* o = out.rgba16f();
-    fog_image<float>(in, depth, cam, v, s, false, [&](std::size_t i, float f, float, const float* rgba) {
+    fog_image<float>(in, depth, cam, v, s, false, y0, y1, [&](std::size_t i, float f, float, const float* rgba) {
       if (f == 1.0f) {  // keep the bits: a half -> float -> half trip would quiet a signalling NaN
         std::memcpy(dst + i * pixel_bytes, src + i * pixel_bytes, pixel_bytes);
         return;
@@ -134,7 +135,27 @@ void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage&
     if (&out != &in) std::memcpy(out.data(), in.data(), in.size_bytes());
     return;
   }
-  fog_into(in, depth, cam, v, s, out);
+  fog_into(in, depth, cam, v, s, out, 0, in.height());
+}
+
+void apply_fog_scalar_rows(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& cam,
+                           const FogSettings& s, int first_row, int end_row) {
+  const Variant v = checked_variant(in, depth, cam, s);
+  if (out.width() != in.width() || out.height() != in.height() || out.format() != in.format())
+    throw Error("apply_fog_scalar_rows: the output must have the input's size and format (" +
+                std::to_string(in.width()) + "x" + std::to_string(in.height()) + " " + to_string(in.format()) + ")");
+  if (first_row < 0 || end_row > in.height() || first_row > end_row)
+    throw Error("apply_fog_scalar_rows: rows [" + std::to_string(first_row) + ", " + std::to_string(end_row) +
+                ") are not inside [0, " + std::to_string(in.height()) + ")");
+  if (!v.needs_pass()) {
+    const std::size_t row_bytes = std::size_t(in.width()) * bytes_per_pixel(in.format());
+    if (&out != &in)
+      std::memcpy(static_cast<std::byte*>(out.data()) + std::size_t(first_row) * row_bytes,
+                  static_cast<const std::byte*>(in.data()) + std::size_t(first_row) * row_bytes,
+                  std::size_t(end_row - first_row) * row_bytes);
+    return;
+  }
+  fog_into(in, depth, cam, v, s, out, first_row, end_row);
 }
 
 template <class T>
@@ -147,7 +168,7 @@ FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const Cam
   r.rgba.resize(4 * in.pixel_count());
   r.factor.resize(in.pixel_count());
   r.amount.resize(in.pixel_count());
-  fog_image<T>(in, depth, cam, v, s, true, [&](std::size_t i, T f, T amount, const T* rgba) {
+  fog_image<T>(in, depth, cam, v, s, true, 0, in.height(), [&](std::size_t i, T f, T amount, const T* rgba) {
     r.factor[i] = f;
     r.amount[i] = amount;
     for (int c = 0; c < 4; ++c) r.rgba[4 * i + c] = rgba[c];

@@ -39,6 +39,8 @@ struct ExrReadRequest {
   std::string depth_channel;         // "" = no depth wanted
   bool depth_single_channel_fallback = false;  // no such channel: use a one-channel part's channel
   float depth_outside = 1.0f;        // depth outside the data window / of empty deep pixels
+  bool keep_half = false;            // color stored as HALF (flat part): read into an rgba16f frame,
+                                     // bit for bit; otherwise (or when false) an rgba32f frame
   std::int64_t max_pixels = std::int64_t(1) << 31;   // per frame (display window); more is corrupt
   std::int64_t max_deep_samples = std::int64_t(1) << 28;  // per deep part
 };
@@ -54,7 +56,7 @@ struct ExrCamera {
 
 struct ExrInput {
   std::string path;          // the file read (or the name given for a memory buffer)
-  ColorImage color;          // display-window frame, float RGBA; empty when !read_color
+  ColorImage color;          // display-window frame, float RGBA (half: see keep_half); empty when !read_color
   DepthImage depth;          // display-window frame; empty when no depth was asked for
   ExrWindows windows;        // of the color part (of the depth part when !read_color)
   int color_part = -1;       // part index of the color (or of the depth when !read_color)
@@ -62,6 +64,7 @@ struct ExrInput {
   int parts = 0;             // parts in the file
   bool deep = false;         // the color came from a deep part, flattened
   std::string layer;         // the layer read
+  int compression = -1;      // Imf::Compression of the color part (of the depth part when !read_color)
   ExrCamera camera;          // from the color part's attributes
 };
 
@@ -72,12 +75,23 @@ ExrInput read_exr(const std::string& path, const ExrReadRequest& request);
 ExrInput read_exr_memory(const void* data, std::size_t size, const std::string& name,
                          const ExrReadRequest& request);
 
+// Output choices of `fogcl apply` (--pixel-type, --compression) for the fogged R, G, B, A.
+struct ExrWriteOptions {
+  bool half = false;      // HALF channels (an rgba16f frame is written bit for bit); else FLOAT
+  int compression = -1;   // Imf::Compression of the color part; -1: the input's
+};
+// "zip" -> Imf::ZIP_COMPRESSION, ... (none, rle, zips, zip, piz, pxr24, b44, dwaa, dwab); throws
+// fogcl::Error naming the value and the choices.
+int parse_exr_compression(const std::string& name);
+const char* exr_compression_name(int compression);  // "zip", ...; "unknown" outside the list
+
 // Writes `fogged` (the frame of `source.color`) as the output of `fogcl apply`: the source file's
 // parts, attributes and other channels are kept (other parts copied as they are stored; the color
-// part rewritten as scanlines with the layer's R, G, B, A in float); with `rgba_only`, only
-// R, G, B, A (unnamed layer) and the windows. Written under a temporary name and renamed.
+// part rewritten as scanlines with the layer's R, G, B, A in float, or as `options` say); with
+// `rgba_only`, only R, G, B, A (unnamed layer) and the windows, compressed as the color part was.
+// The file appears complete or not at all (src/io/atomic_file.h), even after a kill -9.
 void write_exr_output(const std::string& path, const ColorImage& fogged, const ExrInput& source,
-                      bool rgba_only);
+                      bool rgba_only, const ExrWriteOptions& options = {});
 
 // ---- Simple files --------------------------------------------------------------------------------
 

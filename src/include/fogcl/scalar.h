@@ -18,6 +18,12 @@ namespace fogcl {
 void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                       const CameraParams& camera, const FogSettings& settings);
 
+// apply_fog_scalar on rows [first_row, end_row) of the frame only, for callers that spread a frame
+// over their own threads: every pixel gets the bits apply_fog_scalar gives it, rows outside the
+// range are not touched. `out` must already have in's size and format (else fogcl::Error).
+void apply_fog_scalar_rows(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                           const CameraParams& camera, const FogSettings& settings, int first_row, int end_row);
+
 // The fog evaluated in T (float or double), unrounded to the storage format: rgba has
 // 4 * width * height values; factor the fog factors f and amount the fog amounts 1 - f
 // (computed with expm1 for exp/exp2, so a thin fog's amount keeps its relative precision even

@@ -1,0 +1,517 @@
+// `fogcl apply` on sequences (issue 15): the bounded pipeline (order, failures, frames in flight,
+// interrupts), the progress bar's rate and ETA, --pixel-type / --compression / --threads, and
+// outputs that a killed run (SIGKILL mid-write, SIGINT) never leaves partial or as temporaries.
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <thread>
+#include <vector>
+
+#include <Imath/half.h>
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+
+#include "cli/frame_pipeline.h"
+#include "cli/sequence.h"
+#include "fogcl/demo_scene.h"
+#include "fogcl/exr_io.h"
+#include "test_support.h"
+
+namespace fogcl::test {
+namespace {
+
+namespace fs = std::filesystem;
+using cli::FramePipeline;
+using cli::progress_text;
+
+// ---- The pipeline, with stand-in stages ----------------------------------------------------------
+
+struct FakeJob {
+  static inline std::atomic<int> alive{0}, max_alive{0};
+  FakeJob() {
+    const int now = ++alive;
+    int seen = max_alive.load();
+    while (now > seen && !max_alive.compare_exchange_weak(seen, now)) {
+    }
+  }
+  ~FakeJob() { --alive; }
+  int frame = 0;
+  std::string error;
+  std::vector<std::string> trail;  // the stages this frame went through
+};
+
+std::vector<int> range(int first, int last) {
+  std::vector<int> v;
+  for (int f = first; f <= last; ++f) v.push_back(f);
+  return v;
+}
+
+TEST(FramePipeline, WritesInOrderWithAFewFramesInFlight) {
+  FakeJob::max_alive = 0;
+  std::vector<int> written;
+  FramePipeline<FakeJob>::Stages s;
+  s.read = [](FakeJob& j) { j.trail.push_back("read"); };
+  s.fog = [](FakeJob& j) { j.trail.push_back("fog"); };
+  s.write = [&](FakeJob& j) {
+    // A slow first write: an unbounded reader would load every frame meanwhile.
+    if (written.empty()) std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    j.trail.push_back("write");
+    written.push_back(j.frame);
+  };
+  s.done = [](const FakeJob& j) {
+    EXPECT_EQ(j.trail, (std::vector<std::string>{"read", "fog", "write"})) << j.frame;
+    return true;
+  };
+  const auto outcome = FramePipeline<FakeJob>::run(range(1, 40), s, nullptr);
+  EXPECT_EQ(outcome.finished, 40);
+  EXPECT_FALSE(outcome.interrupted);
+  EXPECT_EQ(written, range(1, 40));
+  std::printf("[ in flight] at most %d frames alive\n", FakeJob::max_alive.load());
+  EXPECT_LE(FakeJob::max_alive.load(), 5);
+  EXPECT_EQ(FakeJob::alive.load(), 0);
+}
+
+TEST(FramePipeline, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
+  FramePipeline<FakeJob>::Stages s;
+  std::vector<int> fogged, written, reported;
+  s.read = [](FakeJob& j) {
+    if (j.frame == 3) throw Error("frame three is truncated");
+  };
+  s.fog = [&](FakeJob& j) {
+    fogged.push_back(j.frame);
+    if (j.frame == 5) throw Error("the device is lost");
+  };
+  s.write = [&](FakeJob& j) { written.push_back(j.frame); };
+  s.done = [&](const FakeJob& j) {
+    reported.push_back(j.frame);
+    if (j.frame == 3) {
+      EXPECT_EQ(j.error, "frame three is truncated");
+    }
+    if (j.frame == 5) {
+      EXPECT_EQ(j.error, "the device is lost");
+    }
+    return true;  // --keep-going
+  };
+  auto outcome = FramePipeline<FakeJob>::run(range(1, 6), s, nullptr);
+  EXPECT_EQ(outcome.finished, 6);
+  EXPECT_EQ(reported, range(1, 6));
+  EXPECT_EQ(written, (std::vector<int>{1, 2, 4, 6}));
+  EXPECT_EQ(std::count(fogged.begin(), fogged.end(), 3), 0);
+
+  // Without --keep-going the run stops at the first failure: nothing after it is written.
+  written.clear();
+  reported.clear();
+  s.done = [&](const FakeJob& j) {
+    reported.push_back(j.frame);
+    return j.error.empty();
+  };
+  outcome = FramePipeline<FakeJob>::run(range(1, 30), s, nullptr);
+  EXPECT_EQ(written, (std::vector<int>{1, 2}));
+  EXPECT_EQ(reported, (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(FakeJob::alive.load(), 0);
+}
+
+TEST(FramePipeline, AnInterruptFinishesTheWriteInProgressAndStartsNothing) {
+  std::atomic<int> interrupt{0};
+  std::vector<int> written;
+  FramePipeline<FakeJob>::Stages s;
+  s.read = [](FakeJob&) {};
+  s.fog = [](FakeJob&) {};
+  s.write = [&](FakeJob& j) {
+    if (j.frame == 4) interrupt = SIGINT;  // arrives during frame 4's write
+    written.push_back(j.frame);
+  };
+  s.done = [](const FakeJob&) { return true; };
+  const auto outcome = FramePipeline<FakeJob>::run(range(1, 20), s, &interrupt);
+  EXPECT_TRUE(outcome.interrupted);
+  EXPECT_EQ(outcome.finished, 4);
+  EXPECT_EQ(written, range(1, 4));
+  EXPECT_EQ(FakeJob::alive.load(), 0);
+}
+
+// ---- The progress bar ----------------------------------------------------------------------------
+
+TEST(ProgressText, RateAndEtaComeFromFinishedFramesNotThePipelineFill) {
+  // First frame after 3 s (the pipeline filling), then one every 0.5 s: 2 frames/s, not 5/4.
+  const std::string t = progress_text(5, 25, 3.0, 5.0);
+  EXPECT_NE(t.find("5/25 frames"), std::string::npos) << t;
+  EXPECT_NE(t.find("2.00 frames/s"), std::string::npos) << t;
+  EXPECT_NE(t.find("ETA 0:10"), std::string::npos) << t;  // 20 frames left at 2 frames/s
+  EXPECT_NE(progress_text(1, 200, 2.0, 2.0).find("0.50 frames/s  ETA 6:38"), std::string::npos)
+      << progress_text(1, 200, 2.0, 2.0);
+  const std::string end = progress_text(25, 25, 3.0, 15.0);
+  EXPECT_EQ(end.find("ETA"), std::string::npos) << end;
+  EXPECT_NE(end.find("[==============================]"), std::string::npos) << end;
+  EXPECT_NE(progress_text(0, 10, -1, 0.5).find("0.00 frames/s"), std::string::npos);
+}
+
+// ---- The CLI on sequences ------------------------------------------------------------------------
+
+const char* kFog = " --near 0.3 --far 1000 --fov 60 --mode exp2 --density 0.03 --fog-color 0.6,0.7,0.8";
+
+class Sequence : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = temp_dir() + "/sequence-" + info->name() + "-" + std::to_string(::getpid());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_ + "/in");
+    fs::create_directories(dir_ + "/out");
+  }
+  void TearDown() override {
+    if (!HasFailure()) fs::remove_all(dir_);
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  static std::string frame_name(const std::string& stem, int frame) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s.%04d.exr", stem.c_str(), frame);
+    return buf;
+  }
+  // Demo-scene frames in/color.NNNN.exr (RGBA float, ZIP) and in/depth.NNNN.exr.
+  void make_frames(int count, int width, int height) {
+    for (int f = 1; f <= count; ++f) {
+      DemoView view;
+      view.eye.z += 0.1f * float(f);
+      PerspectiveCamera camera;
+      camera.fov_y_deg = 60.0f;
+      const DemoFrame frame = render_demo_scene(width, height, camera, view);
+      write_exr_rgba(path("in/" + frame_name("color", f)), frame.color);
+      write_exr_depth(path("in/" + frame_name("depth", f)), frame.depth);
+    }
+  }
+  std::string inputs() const {
+    return "apply --color " + path("in/color.####.exr") + " --depth " + path("in/depth.####.exr") + kFog;
+  }
+  std::vector<std::string> out_files() const {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(path("out"))) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  std::string dir_;
+};
+
+std::vector<char> file_bytes(const std::string& p) {
+  std::ifstream f(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+TEST_F(Sequence, ThreadCountsAndThePipelineChangeNoByte) {
+  make_frames(5, 64, 36);
+  std::vector<std::string> devices{"scalar"};  // --threads 3: the scalar pass runs in row bands
+  if (runtime() != nullptr) devices.push_back("cpu");
+  for (const std::string& device : devices) {
+    const std::string fog = std::string(kFog) + " --distance --device " + device;
+    CliRun r = run_cli(inputs() + " --distance --out " + path("out/one.####.exr") + " --threads 1 --device " + device);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_cli(inputs() + " --distance --out " + path("out/three.####.exr") + " --threads 3 --device " + device);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (int f = 1; f <= 5; ++f) {
+      // The same frame fogged on its own, outside any pipeline.
+      const std::string single = path("out/single." + std::to_string(f) + ".exr");
+      r = run_cli("apply --color " + path("in/" + frame_name("color", f)) + " --depth " +
+                  path("in/" + frame_name("depth", f)) + fog + " --threads 1 --out " + single);
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      const std::vector<char> one = file_bytes(path("out/" + frame_name("one", f)));
+      EXPECT_FALSE(one.empty());
+      EXPECT_EQ(one, file_bytes(path("out/" + frame_name("three", f)))) << device << " frame " << f;
+      EXPECT_EQ(one, file_bytes(single)) << device << " frame " << f;
+    }
+  }
+}
+
+// The pieces the CLI runs on its threads give the bits of one call (float and half storage,
+// distance-based: the rays depend on the row).
+TEST(ScalarRows, BandsGiveTheBitsOfOneCall) {
+  for (const ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
+    const TestFrame t = make_test_frame(37, 29, false, format, 7);
+    FogSettings s;
+    s.mode = FogMode::exp2;
+    s.density = 0.01f;
+    s.metric = FogMetric::distance;
+    ColorImage whole, bands(t.color.width(), t.color.height(), format);
+    apply_fog_scalar(t.color, t.depth, whole, t.params, s);
+    for (int y = 0; y < t.color.height();) {
+      const int end = std::min(t.color.height(), y + 1 + y % 5);
+      apply_fog_scalar_rows(t.color, t.depth, bands, t.params, s, y, end);
+      y = end;
+    }
+    EXPECT_EQ(std::memcmp(whole.data(), bands.data(), whole.size_bytes()), 0) << to_string(format);
+  }
+  const TestFrame t = make_test_frame(8, 8, false, ColorFormat::rgba32f);
+  ColorImage small(4, 4);
+  EXPECT_MSG_HAS(error_of([&] { apply_fog_scalar_rows(t.color, t.depth, small, t.params, FogSettings{}, 0, 4); }),
+                 "must have the input's size and format");
+  ColorImage out(8, 8);
+  EXPECT_MSG_HAS(error_of([&] { apply_fog_scalar_rows(t.color, t.depth, out, t.params, FogSettings{}, 6, 9); }),
+                 "rows [6, 9) are not inside [0, 8)");
+}
+
+// Half in, half out: every pixel with f == 1 (sky, unfogged) keeps its 16 bits, NaN payloads,
+// signalling NaNs, -0 and subnormals included; alpha keeps its bits everywhere (DESIGN.md §2).
+TEST_F(Sequence, HalfOutputOfHalfInputKeepsUnfoggedPixelsBitForBit) {
+  const int w = 16, h = 8;
+  const std::uint16_t specials[] = {0x7c01, 0x7e2a, 0xfe01, 0x8000, 0x0001, 0x83ff, 0x7c00, 0xfc00, 0x7bff, 0x3c00};
+  std::vector<std::uint16_t> rgba(std::size_t(w * h * 4));
+  std::vector<float> z(std::size_t(w * h));
+  for (int i = 0; i < w * h; ++i) {
+    const bool sky = i % 3 == 0;
+    for (int c = 0; c < 4; ++c)
+      rgba[std::size_t(4 * i + c)] = sky ? specials[(i + c) % 10] : Imath::half(1.5f + 0.01f * float((i * 7 + c) % 50)).bits();
+    z[std::size_t(i)] = sky ? 1.0f : 0.995f + 0.00004f * float(i % 100);  // 60 to 230 units away
+  }
+  const Imath::Box2i window(Imath::V2i(0, 0), Imath::V2i(w - 1, h - 1));
+  {
+    Imf::Header header(window, window);
+    header.compression() = Imf::PIZ_COMPRESSION;
+    for (const char* c : {"R", "G", "B", "A"}) header.channels().insert(c, Imf::Channel(Imf::HALF));
+    header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    Imf::OutputFile file(path("in/half.0001.exr").c_str(), header);
+    Imf::FrameBuffer fb;
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < 4; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::HALF, (char*)(rgba.data() + c), 8, 8 * std::size_t(w)));
+    fb.insert("Z", Imf::Slice(Imf::FLOAT, (char*)z.data(), 4, 4 * std::size_t(w)));
+    file.setFrameBuffer(fb);
+    file.writePixels(h);
+  }
+  const auto read_half = [&](const std::string& p, Imf::Compression* compression) {
+    Imf::InputFile file(p.c_str());
+    *compression = file.header().compression();
+    for (const char* c : {"R", "G", "B", "A"})
+      EXPECT_EQ(file.header().channels().findChannel(c)->type, Imf::HALF) << p << " " << c;
+    std::vector<std::uint16_t> got(rgba.size());
+    Imf::FrameBuffer fb;
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int c = 0; c < 4; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::HALF, (char*)(got.data() + c), 8, 8 * std::size_t(w)));
+    file.setFrameBuffer(fb);
+    file.readPixels(0, h - 1);
+    return got;
+  };
+  std::vector<std::string> devices{"scalar"};
+  if (runtime() != nullptr) devices.push_back("cpu");
+  for (const std::string& device : devices) {
+    const std::string base = "apply --color " + path("in/half.####.exr") + kFog + " --device " + device;
+    CliRun r = run_cli(base + " --pixel-type half --out " + path("out/" + device + "-half.####.exr"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_cli(base + " --out " + path("out/" + device + "-float.####.exr") + " --compression zip");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    Imf::Compression compression{};
+    const std::vector<std::uint16_t> got = read_half(path("out/" + device + "-half.0001.exr"), &compression);
+    EXPECT_EQ(compression, Imf::PIZ_COMPRESSION) << "default: the input's";
+    const ColorImage as_float = read_exr_color(path("out/" + device + "-float.0001.exr"));
+    Imf::InputFile float_file(path("out/" + device + "-float.0001.exr").c_str());
+    EXPECT_EQ(float_file.header().compression(), Imf::ZIP_COMPRESSION);
+    EXPECT_EQ(float_file.header().channels().findChannel("R")->type, Imf::FLOAT);
+    int sky_checked = 0, fogged_checked = 0;
+    for (int i = 0; i < w * h; ++i) {
+      const bool sky = i % 3 == 0;
+      for (int c = 0; c < 4; ++c) {
+        const std::uint16_t in = rgba[std::size_t(4 * i + c)], out = got[std::size_t(4 * i + c)];
+        if (sky || c == 3) {
+          EXPECT_EQ(out, in) << device << " pixel " << i << " channel " << c;
+          ++sky_checked;
+        } else {
+          // Fogged: the pass ran on half storage; within one half ulp of the float output.
+          const float f = as_float.pixel(i % w, i / w)[c];
+          Imath::half value;
+          value.setBits(out);
+          EXPECT_LE(std::fabs(float(value) - f), half_ulp(f)) << device << " pixel " << i;
+          EXPECT_NE(out, in) << "fogged";
+          ++fogged_checked;
+        }
+      }
+    }
+    EXPECT_GT(sky_checked, 100);
+    EXPECT_GT(fogged_checked, 100);
+  }
+}
+
+TEST_F(Sequence, BadOutputChoicesNameTheValueAndWriteNothing) {
+  make_frames(1, 16, 9);
+  const struct {
+    const char* args;
+    const char* expect;
+  } cases[] = {
+      {" --pixel-type double", "--pixel-type must be half or float (got 'double')"},
+      {" --compression lzma", "--compression must be one of none, rle, zips, zip, piz, pxr24, b44, dwaa, dwab (got 'lzma')"},
+      {" --compression ZIP", "(got 'ZIP')"},
+      {" --threads 0", "--threads must be between 1 and 4096 (got 0)"},
+      {" --threads 5000", "--threads must be between 1 and 4096 (got 5000)"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli(inputs() + c.args + " --device scalar --out " + path("out/o.####.exr"));
+    EXPECT_EQ(r.exit_code, 1) << c.args << ": " << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_TRUE(out_files().empty()) << c.args;
+  }
+  for (const char* compression : {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "dwaa", "dwab"}) {
+    const CliRun r = run_cli(inputs() + " --device scalar --pixel-type half --compression " + compression +
+                             " --out " + path(std::string("out/") + compression + ".####.exr"));
+    ASSERT_EQ(r.exit_code, 0) << compression << ": " << r.output;
+    Imf::InputFile file(path(std::string("out/") + compression + ".0001.exr").c_str());
+    EXPECT_STREQ(exr_compression_name(int(file.header().compression())), compression);
+  }
+}
+
+// ---- Killed runs -----------------------------------------------------------------------------------
+
+// The CLI started in the background, its output in `log`.
+pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries) {
+  std::vector<std::string> words{FOGCL_CLI_PATH};
+  for (std::size_t at = 0; at < args.size();) {
+    const std::size_t end = std::min(args.find(' ', at), args.size());
+    if (end > at) words.push_back(args.substr(at, end - at));
+    at = end + 1;
+  }
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    if (named_temporaries) ::setenv("FOGCL_TEMP_FILES", "named", 1);
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Whether `pid` has a file open in `dir` for writing one: an O_TMPFILE inode shows as
+// "DIR/#INODE (deleted)", a named temporary as "DIR/NAME.tmp-...".
+bool writing_in(pid_t pid, const std::string& dir) {
+  std::error_code ec;
+  for (fs::directory_iterator it("/proc/" + std::to_string(pid) + "/fd", ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code link_ec;
+    const std::string target = fs::read_symlink(it->path(), link_ec).string();
+    if (!link_ec && target.compare(0, dir.size() + 1, dir + "/") == 0 &&
+        (target.find(".tmp-") != std::string::npos || target.find("(deleted)") != std::string::npos))
+      return true;
+  }
+  return false;
+}
+
+int exit_status(pid_t pid) {
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
+}
+
+// Starts the sequence and sends `signo` while an output is being written. False if the run ended
+// before a write was caught.
+bool signal_mid_write(const std::string& args, const std::string& out_dir, const std::string& log, bool named,
+                      int signo, int* status) {
+  const pid_t pid = spawn_cli(args, log, named);
+  bool caught = false;
+  for (;;) {
+    if (writing_in(pid, out_dir)) {
+      ::kill(pid, signo);
+      caught = true;
+      break;
+    }
+    int s = 0;
+    if (::waitpid(pid, &s, WNOHANG) == pid) {
+      *status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  *status = exit_status(pid);
+  return caught;
+}
+
+std::string read_text(const std::string& p) {
+  std::ifstream f(p);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+TEST_F(Sequence, KillDashNineMidWriteLeavesOnlyCompleteFrames) {
+  make_frames(10, 480, 270);
+  const std::string args = inputs() + " --device scalar --threads 1 --out " + path("out/fogged.####.exr");
+  for (const bool named : {false, true}) {
+    SCOPED_TRACE(named ? "named temporaries (FOGCL_TEMP_FILES=named)" : "O_TMPFILE where the file system has it");
+    for (const std::string& f : out_files()) fs::remove(path("out/" + f));
+    int status = 0;
+    ASSERT_TRUE(signal_mid_write(args, path("out"), path("log.txt"), named, SIGKILL, &status))
+        << "the run ended before a write was caught: " << read_text(path("log.txt"));
+    EXPECT_EQ(status, 128 + SIGKILL);
+    std::vector<std::string> temporaries, frames;
+    for (const std::string& f : out_files()) (f.find(".tmp-") != std::string::npos ? temporaries : frames).push_back(f);
+    for (const std::string& f : frames) {
+      EXPECT_EQ(f.size(), std::string("fogged.0001.exr").size()) << f;
+      EXPECT_NO_THROW(read_exr_color(path("out/" + f))) << f << " is not a complete frame";
+    }
+    std::printf("[ killed   ] %s: %zu complete frame(s), %zu temporary file(s) left\n",
+                named ? "named" : "unnamed", frames.size(), temporaries.size());
+    if (named) {
+      // A named temporary stays after a kill -9; the next run on the sequence sweeps it.
+      ASSERT_EQ(temporaries.size(), 1u);
+      const CliRun r = run_cli(args + " --verbose", "FOGCL_TEMP_FILES=named");
+      ASSERT_EQ(r.exit_code, 0) << r.output;
+      EXPECT_NE(r.output.find("removed 1 stale temporary file(s)"), std::string::npos) << r.output;
+      EXPECT_EQ(out_files().size(), 10u);
+      for (const std::string& f : out_files()) EXPECT_EQ(f.find(".tmp-"), std::string::npos) << f;
+    } else {
+      EXPECT_TRUE(temporaries.empty());
+    }
+  }
+}
+
+TEST_F(Sequence, SweepLeavesOtherFilesAndLiveWritersAlone) {
+  make_frames(1, 16, 9);
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  // A dead writer of ours (pid 2^22 + 1 is above Linux's pid_max default), a live one (this test
+  // process, not a fogcl: swept), another machine's, and files that only look alike.
+  const std::string dead = "o.0001.exr.tmp-" + std::string(host) + "-4194305-0";
+  const std::string live_other = "o.0002.exr.tmp-" + std::string(host) + "-" + std::to_string(::getpid()) + "-0";
+  const std::string remote = "o.0003.exr.tmp-some-other-host-4194305-0";
+  const std::string foreign = "notes.txt.tmp-" + std::string(host) + "-4194305-0";
+  for (const std::string& f : {dead, live_other, remote, foreign}) std::ofstream(path("out/" + f)) << "partial";
+  const CliRun r = run_cli(inputs() + " --device scalar --verbose --out " + path("out/o.####.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("removed 2 stale temporary file(s)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("out/" + dead)));
+  EXPECT_FALSE(fs::exists(path("out/" + live_other)));  // its pid runs, but not a fogcl
+  EXPECT_TRUE(fs::exists(path("out/" + remote)));       // another machine's: maybe still writing
+  EXPECT_TRUE(fs::exists(path("out/" + foreign)));      // not one of this sequence's outputs
+}
+
+TEST_F(Sequence, CtrlCSaysHowManyFramesWereWrittenAndLeavesNoPartialFile) {
+  make_frames(10, 480, 270);
+  const std::string args = inputs() + " --device scalar --threads 1 --out " + path("out/fogged.####.exr");
+  int status = 0;
+  ASSERT_TRUE(signal_mid_write(args, path("out"), path("log.txt"), false, SIGINT, &status))
+      << read_text(path("log.txt"));
+  const std::string log = read_text(path("log.txt"));
+  EXPECT_EQ(status, 128 + SIGINT) << log;
+  const std::vector<std::string> files = out_files();
+  EXPECT_NE(log.find("fogcl: interrupted: " + std::to_string(files.size()) + " of 10 frames written"),
+            std::string::npos) << log;
+  EXPECT_LT(files.size(), 10u);
+  for (const std::string& f : files) {
+    EXPECT_EQ(f.find(".tmp-"), std::string::npos) << f;
+    EXPECT_NO_THROW(read_exr_color(path("out/" + f))) << f;
+  }
+}
+
+}  // namespace
+}  // namespace fogcl::test
