@@ -139,7 +139,10 @@ FogVolume parse_volume(const json& j, const KeyReader& r) {
   if (!j.contains("center")) throw Error(r.where + "'center' is missing (every volume needs \"center\": [x, y, z])");
   if (!j.contains("radius")) throw Error(r.where + "'radius' is missing (every volume needs \"radius\": r > 0)");
   FogVolume v;
-  for (const auto& [key, value] : j.items()) {
+  for (const auto& item : j.items()) {
+    // Named copies, not structured bindings: lambdas below use them (C++17 cannot capture bindings).
+    const std::string key = item.key();
+    const nlohmann::json& value = item.value();
     const auto field = volume_fields().find(key);
     if (field == volume_fields().end()) {
       std::string best;
