@@ -92,7 +92,7 @@ class VolumeStage {
 // backend after the deferred ones; `deferred` is the fog of the row that runs both passes.
 struct DemoOptions;
 class Backend;
-std::vector<FogVolume> demo_volumes();
+std::vector<FogVolume> demo_volumes(VolumeIntegrator integrator);
 void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>& backends,
                       const FogSettings& deferred);
 
