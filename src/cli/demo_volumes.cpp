@@ -148,9 +148,10 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
     txt << matrix.str() << "\n";
   }
 
-  std::printf("\nvolumetric fog volumes (volumes.json, volumes-physical.json): 4 volumes, %d steps, half resolution, "
-              "depth-aware; shadow map %dx%d\n",
-              VolumeSettings{}.steps, shadow.depth.width(), shadow.depth.height());
+  std::printf(
+      "\nvolumetric fog volumes (volumes.json, volumes-physical.json): 4 volumes, %d steps, half resolution, "
+      "depth-aware; shadow map %dx%d\n",
+      VolumeSettings{}.steps, shadow.depth.width(), shadow.depth.height());
   std::printf("(opencl: median of 3 runs after a warm-up; scalar: 1 run, the march is slow on one thread)\n");
   std::printf("%-26s %-8s %12s %14s\n", "setting", "path", "ms", "max err f64");
 
@@ -173,8 +174,9 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
       for (int y = 0; y < mid.height(); ++y)
         for (int x = 0; x < mid.width(); ++x) {
           const std::size_t i = 4 * (std::size_t(y) * std::size_t(mid.width()) + std::size_t(x));
-          mid.set_pixel(x, y, glm::vec4(float(ref.rgba[i]), float(ref.rgba[i + 1]), float(ref.rgba[i + 2]),
-                                        float(ref.rgba[i + 3])));
+          mid.set_pixel(
+              x, y,
+              glm::vec4(float(ref.rgba[i]), float(ref.rgba[i + 1]), float(ref.rgba[i + 2]), float(ref.rgba[i + 3])));
         }
       ref_fog = fog_scalar<double>(mid, frame.depth, frame.params, deferred);
     }
@@ -212,15 +214,16 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
       write_png_preview(path(stem + ".png"), out);
     }
   }
-  std::printf("\nthe same with fogcl apply (volumes-stylized-shadow; physical: --integrator physical --volumes %s):\n  fogcl apply --color %s --depth %s --out OUT.exr "
-              "--near %g --far %g --fov %g --volumes %s --eye %s --forward %s --up %s --light-dir %s --light-color %s "
-              "--shadow-map %s --light-view-proj %s\n",
-              path("volumes-physical.json").c_str(), path("scene.exr").c_str(), path("scene-depth.exr").c_str(),
-              double(camera.near_plane),
-              double(camera.far_plane), double(camera.fov_y_deg), path("volumes.json").c_str(),
-              vec(scene.pose.eye).c_str(), vec(scene.pose.forward).c_str(), vec(scene.pose.up).c_str(),
-              vec(scene.light.direction).c_str(), vec(scene.light.color).c_str(), path("light-shadow.exr").c_str(),
-              matrix.str().c_str());
+  std::printf(
+      "\nthe same with fogcl apply (volumes-stylized-shadow; physical: --integrator physical --volumes %s):\n  fogcl "
+      "apply --color %s --depth %s --out OUT.exr "
+      "--near %g --far %g --fov %g --volumes %s --eye %s --forward %s --up %s --light-dir %s --light-color %s "
+      "--shadow-map %s --light-view-proj %s\n",
+      path("volumes-physical.json").c_str(), path("scene.exr").c_str(), path("scene-depth.exr").c_str(),
+      double(camera.near_plane), double(camera.far_plane), double(camera.fov_y_deg), path("volumes.json").c_str(),
+      vec(scene.pose.eye).c_str(), vec(scene.pose.forward).c_str(), vec(scene.pose.up).c_str(),
+      vec(scene.light.direction).c_str(), vec(scene.light.color).c_str(), path("light-shadow.exr").c_str(),
+      matrix.str().c_str());
 }
 
 }  // namespace fogcl::cli
