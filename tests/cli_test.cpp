@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -41,6 +42,31 @@ TEST_F(Cli, DemoWritesImagesAndATable) {
   if (runtime() != nullptr) {
     EXPECT_TRUE(fs::exists(in("exp2-distance-opencl.exr")));
   }
+}
+
+// The demo's volumetric rows and their inputs; the `fogcl apply` line it prints reproduces its
+// volumes-stylized-shadow row bit for bit (same inputs, same pass).
+TEST_F(Cli, DemoVolumeRowsAreReproducedByApply) {
+  for (const char* f : {"volumes.json", "volumes-physical.json", "light-shadow.exr", "light-view-proj.txt",
+                        "volumes-stylized-scalar.png", "volumes-physical-shadow-scalar.exr", "volumes-shadow+exp2-scalar.png"})
+    EXPECT_TRUE(fs::exists(in(f))) << f;
+  for (const char* row : {"volumes-stylized ", "volumes-stylized-shadow ", "volumes-physical ", "volumes-physical-shadow ",
+                          "volumes-shadow+exp2 "})
+    EXPECT_NE(demo_output_.find(row), std::string::npos) << row << " in " << demo_output_;
+  const std::size_t at = demo_output_.find("  fogcl apply ");
+  ASSERT_NE(at, std::string::npos) << demo_output_;
+  std::string line = demo_output_.substr(at + 8, demo_output_.find('\n', at) - at - 8);
+  const std::string kind = runtime() ? "opencl" : "scalar";
+  line.replace(line.find("OUT.exr"), 7, in("apply-volumes.exr"));
+  const CliRun r = run_cli(line + " --device " + (runtime() ? "cpu" : "scalar"));
+  ASSERT_EQ(r.exit_code, 0) << line << "\n" << r.output;
+  const ColorImage got = read_exr_color(in("apply-volumes.exr"));
+  const ColorImage want = read_exr_color(in("volumes-stylized-shadow-" + kind + ".exr"));
+  ASSERT_EQ(got.size_bytes(), want.size_bytes());
+  const std::size_t differing = std::memcmp(got.data(), want.data(), got.size_bytes()) == 0 ? 0 : 1;
+  std::printf("[ measured ] demo's fogcl apply line vs its %s row: %s\n", kind.c_str(),
+              differing ? "differs" : "bit-identical");
+  EXPECT_EQ(differing, 0u);
 }
 
 TEST_F(Cli, ApplyMatchesTheDoublePath) {

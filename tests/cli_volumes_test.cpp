@@ -129,13 +129,17 @@ class CliVolumes : public ::testing::Test {
   // `change` replaces a flag's value ("" leaves the flag out).
   static std::string base_args(const std::map<std::string, std::string>& change = {}) {
     const VolumeScene s = scene();
-    std::map<std::string, std::string> flags{
-        {"--color", in("scene.exr")},     {"--depth", in("scene-depth.exr")},
-        {"--near", "0.3"},                {"--far", "1000"},
-        {"--fov", "60"},                  {"--volumes", in("volumes.json")},
-        {"--eye", vec3_text(s.pose.eye)}, {"--forward", vec3_text(s.pose.forward)},
-        {"--up", vec3_text(s.pose.up)},   {"--light-dir", vec3_text(s.light.direction)},
-        {"--light-color", vec3_text(s.light.color)}};
+    std::map<std::string, std::string> flags{{"--color", in("scene.exr")},
+                                             {"--depth", in("scene-depth.exr")},
+                                             {"--near", "0.3"},
+                                             {"--far", "1000"},
+                                             {"--fov", "60"},
+                                             {"--volumes", in("volumes.json")},
+                                             {"--eye", vec3_text(s.pose.eye)},
+                                             {"--forward", vec3_text(s.pose.forward)},
+                                             {"--up", vec3_text(s.pose.up)},
+                                             {"--light-dir", vec3_text(s.light.direction)},
+                                             {"--light-color", vec3_text(s.light.color)}};
     for (const auto& [flag, value] : change) flags[flag] = value;
     std::string args = "apply";
     for (const auto& [flag, value] : flags)
@@ -164,11 +168,13 @@ TEST_F(CliVolumes, ScalarPathEqualsTheLibraryBitForBit) {
   const VolumeScene s = scene();
   ColorImage want;
   apply_volumes_scalar(frame_->color, frame_->depth, want, frame_->params, s, VolumeSettings{});
-  const VolumeResult<double> ref = volumes_scalar<double>(frame_->color, frame_->depth, frame_->params, s, VolumeSettings{});
+  const VolumeResult<double> ref =
+      volumes_scalar<double>(frame_->color, frame_->depth, frame_->params, s, VolumeSettings{});
   const std::size_t diff = differing_floats(got, want);
-  std::printf("[ measured ] CLI --device scalar vs apply_volumes_scalar: %zu differing floats; vs double: max %.3g "
-              "(%zu volumes visible)\n",
-              diff, max_abs_rgb_error(got, ref), ref.visible);
+  std::printf(
+      "[ measured ] CLI --device scalar vs apply_volumes_scalar: %zu differing floats; vs double: max %.3g "
+      "(%zu volumes visible)\n",
+      diff, max_abs_rgb_error(got, ref), ref.visible);
   EXPECT_EQ(diff, 0u);
   EXPECT_EQ(ref.visible, 3u);
   EXPECT_LE(max_abs_rgb_error(got, ref), 1e-4);
@@ -183,15 +189,17 @@ TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
   VolumePass pass(*runtime());
   ColorImage want;
   pass.apply(frame_->color, frame_->depth, want, frame_->params, s, VolumeSettings{});
-  const VolumeResult<double> ref = volumes_scalar<double>(frame_->color, frame_->depth, frame_->params, s, VolumeSettings{});
+  const VolumeResult<double> ref =
+      volumes_scalar<double>(frame_->color, frame_->depth, frame_->params, s, VolumeSettings{});
   const std::size_t diff = differing_floats(got, want);
   std::printf("[ measured ] CLI --device cpu vs VolumePass::apply: %zu differing floats; vs double: max %.3g\n", diff,
               max_abs_rgb_error(got, ref));
   EXPECT_EQ(diff, 0u);
   EXPECT_LE(max_abs_rgb_error(got, ref), 1e-4);
   // --verbose names the variant.
-  for (const char* part : {"volumes: 3 of 3 visible", "stylized integrator", "50 steps", "half resolution (32x18 target)",
-                           "depth-aware upsampling", "buffer sampling", "march build options: ", "composite build options: "})
+  for (const char* part :
+       {"volumes: 3 of 3 visible", "stylized integrator", "50 steps", "half resolution (32x18 target)",
+        "depth-aware upsampling", "buffer sampling", "march build options: ", "composite build options: "})
     EXPECT_MSG_HAS(output, part);
   EXPECT_MSG_HAS(output, pass.last_march_options());
 
@@ -201,8 +209,9 @@ TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
   st.noise_sampling = NoiseSampling::image;
   pass.apply(frame_->color, frame_->depth, want, frame_->params, s, st);
   const std::size_t image_diff = differing_floats(image, want);
-  std::printf("[ measured ] CLI --noise-sampling image vs VolumePass::apply: %zu differing floats; vs double: max %.3g\n",
-              image_diff, max_abs_rgb_error(image, ref));
+  std::printf(
+      "[ measured ] CLI --noise-sampling image vs VolumePass::apply: %zu differing floats; vs double: max %.3g\n",
+      image_diff, max_abs_rgb_error(image, ref));
   EXPECT_EQ(image_diff, 0u);
   EXPECT_MSG_HAS(output, "image sampling");
   EXPECT_MSG_HAS(output, pass.last_march_options());
@@ -239,8 +248,9 @@ TEST_F(CliVolumes, EveryFlagReachesThePass) {
   }
   apply_volumes_scalar(frame_->color, frame_->depth, plain, frame_->params, scene(), VolumeSettings{});
   const std::size_t diff = differing_floats(got, want), from_default = differing_floats(got, plain);
-  std::printf("[ measured ] CLI with every volume flag vs the library: %zu differing floats; vs default settings: %zu\n",
-              diff, from_default);
+  std::printf(
+      "[ measured ] CLI with every volume flag vs the library: %zu differing floats; vs default settings: %zu\n", diff,
+      from_default);
   EXPECT_EQ(diff, 0u);
   EXPECT_GT(from_default, 100u);
   // Each setting alone changes the picture (with the others at the CLI's values).
@@ -271,16 +281,18 @@ TEST_F(CliVolumes, ModeOffLeavesUnfoggedPixelsBitIdentical) {
   // The volumes behind the sphere and on the ground: the camera is outside both.
   const std::string json = kVolumesJson;
   write_text(in("outside.json"), "{\"volumes\": [" + json.substr(json.find("{\"center\": [3,")));
-  const ColorImage got = run_ok(base_args({{"--volumes", in("outside.json")}}) + " --mode off --device scalar", "off.exr");
+  const ColorImage got =
+      run_ok(base_args({{"--volumes", in("outside.json")}}) + " --mode off --device scalar", "off.exr");
   ASSERT_GT(got.width(), 0);
   VolumeScene s = scene();
   s.volumes.erase(s.volumes.begin());
-  const VolumeResult<double> ref = volumes_scalar<double>(frame_->color, frame_->depth, frame_->params, s, VolumeSettings{});
+  const VolumeResult<double> ref =
+      volumes_scalar<double>(frame_->color, frame_->depth, frame_->params, s, VolumeSettings{});
   std::size_t untouched = 0, same = 0, changed = 0;
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x) {
-      const bool equal = std::memcmp(&got.rgba32f()[4 * (y * kWidth + x)], &frame_->color.rgba32f()[4 * (y * kWidth + x)],
-                                     4 * sizeof(float)) == 0;
+      const bool equal = std::memcmp(&got.rgba32f()[4 * (y * kWidth + x)],
+                                     &frame_->color.rgba32f()[4 * (y * kWidth + x)], 4 * sizeof(float)) == 0;
       if (ref.coverage[std::size_t(y) * kWidth + x] == 0) {
         ++untouched;
         same += equal;
@@ -288,9 +300,10 @@ TEST_F(CliVolumes, ModeOffLeavesUnfoggedPixelsBitIdentical) {
         changed += !equal;
       }
     }
-  std::printf("[ measured ] --mode off --volumes: %zu of %zu pixels the fog does not reach, %zu of them bit-identical; "
-              "%zu fogged pixels changed\n",
-              untouched, std::size_t(kWidth * kHeight), same, changed);
+  std::printf(
+      "[ measured ] --mode off --volumes: %zu of %zu pixels the fog does not reach, %zu of them bit-identical; "
+      "%zu fogged pixels changed\n",
+      untouched, std::size_t(kWidth * kHeight), same, changed);
   EXPECT_GT(untouched, 0u);
   EXPECT_EQ(same, untouched);
   EXPECT_GT(changed, 100u);
@@ -309,7 +322,8 @@ TEST_F(CliVolumes, VolumesThenDeferredFogEqualsTheLibrary) {
   f.color = glm::vec3(0.6f, 0.7f, 0.8f);
   apply_fog_scalar(want, frame_->depth, want, frame_->params, f);
   const std::size_t diff = differing_floats(got, want);
-  std::printf("[ measured ] CLI volumes + exp2 vs the library's volumes then deferred fog: %zu differing floats\n", diff);
+  std::printf("[ measured ] CLI volumes + exp2 vs the library's volumes then deferred fog: %zu differing floats\n",
+              diff);
   EXPECT_EQ(diff, 0u);
   // Without --mode the deferred fog stays off: the volumes alone.
   const ColorImage alone = run_ok(base_args() + " --device scalar", "alone.exr");
@@ -323,7 +337,8 @@ TEST_F(CliVolumes, VolumesThenDeferredFogEqualsTheLibrary) {
 TEST_F(CliVolumes, SequencesScrollTheNoiseAndChangeTheJitter) {
   for (int f : {1, 2}) {
     fs::copy_file(in("scene.exr"), in("seq." + std::to_string(f) + ".exr"), fs::copy_options::overwrite_existing);
-    fs::copy_file(in("scene-depth.exr"), in("seqz." + std::to_string(f) + ".exr"), fs::copy_options::overwrite_existing);
+    fs::copy_file(in("scene-depth.exr"), in("seqz." + std::to_string(f) + ".exr"),
+                  fs::copy_options::overwrite_existing);
   }
   const std::string args =
       base_args({{"--color", in("seq.#.exr")}, {"--depth", in("seqz.#.exr")}}) + " --device scalar --fps 10";
@@ -342,8 +357,9 @@ TEST_F(CliVolumes, SequencesScrollTheNoiseAndChangeTheJitter) {
     s.time = 0.25f;
     apply_volumes_scalar(frame_->color, frame_->depth, want, frame_->params, s, VolumeSettings{});
     const std::size_t diff_fixed = differing_floats(read_exr_color(in("seqfix." + std::to_string(f) + ".exr")), want);
-    std::printf("[ measured ] sequence frame %d: %zu differing floats (frame %d, time %g); with --frame 5 --time 0.25: %zu\n",
-                f, diff, f, f / 10.0, diff_fixed);
+    std::printf(
+        "[ measured ] sequence frame %d: %zu differing floats (frame %d, time %g); with --frame 5 --time 0.25: %zu\n",
+        f, diff, f, f / 10.0, diff_fixed);
     EXPECT_EQ(diff, 0u);
     EXPECT_EQ(diff_fixed, 0u);
   }
@@ -355,8 +371,8 @@ TEST_F(CliVolumes, SequencesScrollTheNoiseAndChangeTheJitter) {
 // ---- Bad input: one line naming the value, exit 1, no file ------------------------------------
 
 struct BadCase {
-  std::string what;     // the case, for failure messages
-  std::string args;     // appended to the base arguments (or replacing them, see below)
+  std::string what;                 // the case, for failure messages
+  std::string args;                 // appended to the base arguments (or replacing them, see below)
   std::vector<std::string> expect;  // parts the message must contain
 };
 
@@ -366,7 +382,8 @@ void expect_rejected(const std::string& args, const std::string& out, const BadC
   std::printf("[ message  ] %-28s %s", c.what.c_str(), r.output.c_str());
   EXPECT_EQ(r.exit_code, 1) << c.what << ": " << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << c.what << ": " << r.output;
-  for (const std::string& part : c.expect) EXPECT_NE(r.output.find(part), std::string::npos) << c.what << ": lacks '" << part << "' in " << r.output;
+  for (const std::string& part : c.expect)
+    EXPECT_NE(r.output.find(part), std::string::npos) << c.what << ": lacks '" << part << "' in " << r.output;
   EXPECT_FALSE(fs::exists(out)) << c.what;
 }
 
@@ -376,34 +393,48 @@ TEST_F(CliVolumes, BadVolumesJsonIsOneLineNamingVolumeKeyAndRule) {
     std::string what, json;
     std::vector<std::string> expect;
   } cases[] = {
-      {"unknown key", R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": 2, "desnity": 0.5}]})",
+      {"unknown key",
+       R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": 2, "desnity": 0.5}]})",
        {"volume 1", "unknown key 'desnity'", "did you mean 'density'"}},
-      {"wrong type", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "density": "thick"}]})",
+      {"wrong type",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "density": "thick"}]})",
        {"volume 0", "'density'", "must be a number", "\"thick\""}},
-      {"wrong bool type", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "noise": 1}]})",
+      {"wrong bool type",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "noise": 1}]})",
        {"volume 0", "'noise'", "true or false"}},
-      {"short vector", R"({"volumes": [{"center": [0, 1], "radius": 2}]})",
+      {"short vector",
+       R"({"volumes": [{"center": [0, 1], "radius": 2}]})",
        {"volume 0", "'center'", "array of 3 numbers"}},
       {"vector not an array", R"({"volumes": [{"center": 3, "radius": 2}]})", {"volume 0", "'center'", "array of 3"}},
-      {"string in a vector", R"({"volumes": [{"center": [0, "a", 0], "radius": 2}]})",
+      {"string in a vector",
+       R"({"volumes": [{"center": [0, "a", 0], "radius": 2}]})",
        {"volume 0", "'center[1]'", "must be a number"}},
-      {"color length", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "fog_color": [1, 1]}]})",
+      {"color length",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "fog_color": [1, 1]}]})",
        {"volume 0", "'fog_color'", "3 or 4 numbers"}},
-      {"negative radius", R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": -2}]})",
+      {"negative radius",
+       R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": -2}]})",
        {"volume 1", "'radius'", "must be > 0", "-2"}},
-      {"negative density", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "density": -0.1}]})",
+      {"negative density",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "density": -0.1}]})",
        {"volume 0", "'density'", ">= 0", "-0.1"}},
-      {"library range", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "fog_cutoff": 1.5}]})",
+      {"library range",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "fog_cutoff": 1.5}]})",
        {"volume 0", "fog_cutoff", "[0, 1)", "1.5"}},
-      {"anisotropy range", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "anisotropy": 1}]})",
+      {"anisotropy range",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "anisotropy": 1}]})",
        {"volume 0", "anisotropy", "(-1, 1)"}},
-      {"inf (overflowing double)", R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": 2, "density": 1e999}]})",
+      {"inf (overflowing double)",
+       R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": 2, "density": 1e999}]})",
        {"volume 1", "'density'", "finite", "1e999"}},
-      {"inf in a vector", R"({"volumes": [{"center": [0, -1e999, 0], "radius": 2}]})",
+      {"inf in a vector",
+       R"({"volumes": [{"center": [0, -1e999, 0], "radius": 2}]})",
        {"volume 0", "'center'", "finite"}},
-      {"overflowing float", R"({"volumes": [{"center": [0, 1, 0], "radius": 1e39}]})",
+      {"overflowing float",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 1e39}]})",
        {"volume 0", "'radius'", "finite", "1e+39"}},
-      {"NaN literal", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "density": NaN}]})",
+      {"NaN literal",
+       R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "density": NaN}]})",
        {"malformed JSON", "line 1, column", "invalid literal"}},
       {"missing volumes", R"({})", {"'volumes' is missing"}},
       {"volumes not an array", R"({"volumes": {"center": [0, 1, 0]}})", {"'volumes' must be an array"}},
@@ -411,9 +442,11 @@ TEST_F(CliVolumes, BadVolumesJsonIsOneLineNamingVolumeKeyAndRule) {
       {"volume not an object", R"({"volumes": [3]})", {"volume 0", "must be an object"}},
       {"missing center", R"({"volumes": [{"radius": 2}]})", {"volume 0", "'center' is missing"}},
       {"missing radius", R"({"volumes": [{"center": [0, 1, 0]}]})", {"volume 0", "'radius' is missing"}},
-      {"duplicate key", R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": 2, "radius": 3}]})",
+      {"duplicate key",
+       R"({"volumes": [)" + ok + R"(, {"center": [0, 1, 0], "radius": 2, "radius": 3}]})",
        {"volume 1", "duplicate key 'radius'"}},
-      {"malformed JSON", "{\"volumes\": [\n  {\"center\": [0, 1, 0], \"radius\": 2,}\n]}",
+      {"malformed JSON",
+       "{\"volumes\": [\n  {\"center\": [0, 1, 0], \"radius\": 2,}\n]}",
        {"malformed JSON", "line 2, column"}},
       {"not JSON at all", "volumes = 3", {"malformed JSON", "line 1, column 1"}},
   };
@@ -433,8 +466,8 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
   write_text(in("not-an-exr.exr"), "this is not an OpenEXR file\n");
   const std::string shadow = " --shadow-map " + in("shadow.exr") + " --light-view-proj ";
   std::string nan_matrix = matrix_, singular;
-  nan_matrix.replace(0, nan_matrix.find(','), "nan");  // row 0, column 0
-  for (int i = 0; i < 16; ++i) singular += std::string(i ? "," : "") + (i < 8 ? "1" : "0") ;  // rank 1 rows
+  nan_matrix.replace(0, nan_matrix.find(','), "nan");                                        // row 0, column 0
+  for (int i = 0; i < 16; ++i) singular += std::string(i ? "," : "") + (i < 8 ? "1" : "0");  // rank 1 rows
   // Flags of base_args() given another value.
   const struct {
     std::string what;
@@ -451,11 +484,13 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
       {"missing --eye", {{"--eye", ""}}, {"--eye is required with --volumes"}},
       {"missing --forward", {{"--forward", ""}}, {"--forward is required with --volumes"}},
       {"missing --up", {{"--up", ""}}, {"--up is required with --volumes"}},
-      {"no mode, no volumes", {{"--volumes", ""}, {"--eye", ""}, {"--forward", ""}, {"--up", ""}, {"--light-dir", ""}, {"--light-color", ""}},
+      {"no mode, no volumes",
+       {{"--volumes", ""}, {"--eye", ""}, {"--forward", ""}, {"--up", ""}, {"--light-dir", ""}, {"--light-color", ""}},
        {"--mode is required"}},
       {"volume flag without --volumes", {{"--volumes", ""}, {"--mode", "exp"}}, {"--eye needs --volumes"}},
   };
-  for (const auto& c : changed) expect_rejected(base_args(c.change) + " --device scalar", in("bad.exr"), {c.what, "", c.expect});
+  for (const auto& c : changed)
+    expect_rejected(base_args(c.change) + " --device scalar", in("bad.exr"), {c.what, "", c.expect});
 
   const std::string base = base_args() + " --device scalar";
   const BadCase cases[] = {
@@ -466,12 +501,20 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
       {"time", " --time inf", {"--time", "finite"}},
       {"light matrix NaN", shadow + nan_matrix, {"--light-view-proj", "row 0, column 0", "finite", "nan"}},
       {"light matrix singular", shadow + singular, {"--light-view-proj", "singular", "determinant"}},
-      {"light matrix 15 numbers", shadow + matrix_.substr(0, matrix_.rfind(',')), {"--light-view-proj", "16", "got 15"}},
-      {"light matrix word", shadow + "a" + matrix_.substr(matrix_.find(',')), {"--light-view-proj", "element 0", "'a'"}},
-      {"shadow map unreadable", " --shadow-map " + in("not-an-exr.exr") + " --light-view-proj " + matrix_,
+      {"light matrix 15 numbers",
+       shadow + matrix_.substr(0, matrix_.rfind(',')),
+       {"--light-view-proj", "16", "got 15"}},
+      {"light matrix word",
+       shadow + "a" + matrix_.substr(matrix_.find(',')),
+       {"--light-view-proj", "element 0", "'a'"}},
+      {"shadow map unreadable",
+       " --shadow-map " + in("not-an-exr.exr") + " --light-view-proj " + matrix_,
        {"--shadow-map", "not-an-exr.exr"}},
-      {"shadow map missing", " --shadow-map " + in("none.exr") + " --light-view-proj " + matrix_, {"--shadow-map", "none.exr"}},
-      {"shadow map without depth", " --shadow-map " + in("scene.exr") + " --light-view-proj " + matrix_,
+      {"shadow map missing",
+       " --shadow-map " + in("none.exr") + " --light-view-proj " + matrix_,
+       {"--shadow-map", "none.exr"}},
+      {"shadow map without depth",
+       " --shadow-map " + in("scene.exr") + " --light-view-proj " + matrix_,
        {"--shadow-map", "scene.exr", "Z"}},
       {"shadow map without matrix", " --shadow-map " + in("shadow.exr"), {"--shadow-map needs --light-view-proj"}},
       {"matrix without shadow map", " --light-view-proj " + matrix_, {"--light-view-proj needs --shadow-map"}},
@@ -482,9 +525,10 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
 TEST_F(CliVolumes, HelpDocumentsEveryVolumeFlag) {
   const CliRun r = run_cli("apply --help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* flag : {"--volumes", "--eye", "--forward", "--up", "--light-dir", "--light-color", "--time", "--frame",
-                           "--fps", "--integrator", "--steps", "--volume-resolution", "--upsample", "--noise-size",
-                           "--noise-seed", "--noise-sampling", "--shadow-map", "--light-view-proj", "--shadow-reversed-z"})
+  for (const char* flag :
+       {"--volumes", "--eye", "--forward", "--up", "--light-dir", "--light-color", "--time", "--frame", "--fps",
+        "--integrator", "--steps", "--volume-resolution", "--upsample", "--noise-size", "--noise-seed",
+        "--noise-sampling", "--shadow-map", "--light-view-proj", "--shadow-reversed-z"})
     EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
 }
 

@@ -17,8 +17,8 @@ namespace fogcl::test {
 namespace {
 
 // The scene of fogcl/demo_scene.h's comment: centre and radius of each sphere, the ground y = 0.
-const glm::dvec4 kSpheres[] = {{-0.9, 0.5, -3.5, 0.5}, {2.2, 1, -0.5, 1},  {-3.8, 1.5, 7, 1.5}, {-12, 2, 16, 2},
-                               {-3, 3, 27, 3},         {5, 4, 42, 4},       {34, 5, 56, 5}};
+const glm::dvec4 kSpheres[] = {{-0.9, 0.5, -3.5, 0.5}, {2.2, 1, -0.5, 1}, {-3.8, 1.5, 7, 1.5}, {-12, 2, 16, 2},
+                               {-3, 3, 27, 3},         {5, 4, 42, 4},     {34, 5, 56, 5}};
 
 // First hit t >= 0 of o + t d with the spheres and the ground, +inf when none.
 double cast(const glm::dvec3& o, const glm::dvec3& d) {

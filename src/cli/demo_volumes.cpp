@@ -19,51 +19,69 @@
 
 namespace fogcl::cli {
 
-std::vector<FogVolume> demo_volumes() {
-  // Noise tiling 0.12-0.25 per world unit: one noise period spans 4-8 units, a few billows per
-  // volume in this ~50-unit scene (the seed's 0.015 suits its 100s-of-units scenes).
-  FogVolume around;  // the camera (0, 1.6, -6) is inside
+std::vector<FogVolume> demo_volumes(VolumeIntegrator integrator) {
+  // Noise tiling 0.1-0.25 per world unit: one noise period spans 4-10 units, a few billows per
+  // volume in this ~50-unit scene (the seed's 0.015 suits its 100s-of-units scenes). Fades of a
+  // few units (the seed's 20 / 10 would thin these 3-12 unit spheres to nothing), and a cut-off
+  // that leaves gaps between the billows. Values chosen by looking at the PNGs.
+  FogVolume around;  // the camera (0, 1.6, -6) is inside: a light haze with gaps
   around.center = glm::vec3(0.5f, 1.5f, -4.0f);
   around.radius = 6.0f;
-  around.density = 0.5f;
-  around.fade_edge = 2.5f;
-  around.proximity_fade = 1.0f;
-  around.fog_cutoff = 0.2f;
-  around.tiling = glm::vec3(0.16f);
-  around.detail_tiling = glm::vec3(0.45f);
-  around.detail_strength = 0.5f;
+  around.density = 1.2f;
+  around.fade_edge = 1.5f;
+  around.proximity_fade = 0.5f;
+  around.fog_cutoff = 0.5f;
+  around.tiling = glm::vec3(0.2f);
+  around.detail_tiling = glm::vec3(0.6f);
+  around.detail_strength = 0.4f;
   around.speed = glm::vec3(0.6f, -0.1f, 0.3f);
-  around.fog_color = glm::vec4(0.85f, 0.88f, 0.95f, 1.0f);
+  around.fog_color = glm::vec4(0.9f, 0.92f, 1.0f, 1.0f);
 
   FogVolume behind = around;  // behind the (2.2, 1, -0.5) sphere, seen past its silhouette
   behind.center = glm::vec3(3.2f, 1.8f, 3.5f);
   behind.radius = 3.5f;
-  behind.density = 0.9f;
-  behind.fog_cutoff = 0.15f;
-  behind.tiling = glm::vec3(0.22f);
-  behind.fog_color = glm::vec4(1.0f, 0.85f, 0.7f, 1.0f);
+  behind.density = 4.0f;
+  behind.fade_edge = 1.0f;
+  behind.fog_cutoff = 0.35f;
+  behind.tiling = glm::vec3(0.25f);
+  behind.detail_tiling = glm::vec3(0.7f);
+  behind.fog_color = glm::vec4(1.0f, 0.7f, 0.45f, 1.0f);
 
   FogVolume ground = around;  // crossing the ground, thinning out with height
   ground.center = glm::vec3(-5.0f, 0.0f, 12.0f);
   ground.radius = 7.0f;
-  ground.max_y = 3.0f;
-  ground.fade_y = 2.0f;
-  ground.density = 0.8f;
-  ground.fog_cutoff = 0.1f;
-  ground.tiling = glm::vec3(0.14f);
-  ground.fog_color = glm::vec4(0.7f, 0.8f, 1.0f, 1.0f);
+  ground.max_y = 5.0f;
+  ground.fade_y = 3.0f;
+  ground.density = 6.0f;
+  ground.fog_cutoff = 0.25f;
+  ground.tiling = glm::vec3(0.15f);
+  ground.detail_tiling = glm::vec3(0.5f);
+  ground.fog_color = glm::vec4(0.55f, 0.7f, 1.0f, 1.0f);
 
   FogVolume bank = around;  // a wide bank around the far spheres
   bank.center = glm::vec3(4.0f, 2.0f, 34.0f);
   bank.radius = 12.0f;
-  bank.max_y = 6.0f;
+  bank.max_y = 7.0f;
   bank.fade_y = 4.0f;
-  bank.fade_edge = 5.0f;
-  bank.density = 0.6f;
+  bank.fade_edge = 3.0f;
+  bank.proximity_fade = 1.0f;
+  bank.density = 6.0f;
+  bank.fog_cutoff = 0.3f;
   bank.tiling = glm::vec3(0.1f);
   bank.detail_tiling = glm::vec3(0.3f);
-  bank.fog_color = glm::vec4(0.9f, 0.92f, 1.0f, 1.0f);
-  return {around, behind, ground, bank};
+  bank.fog_color = glm::vec4(0.85f, 0.9f, 1.0f, 1.0f);
+
+  std::vector<FogVolume> volumes{around, behind, ground, bank};
+  if (integrator == VolumeIntegrator::physical)
+    for (FogVolume& v : volumes) {
+      // density is then sigma_t [1/unit]: 0.15 x the stylized alpha scale keeps the thick parts
+      // translucent; a sky-coloured ambient (the seed's 0.1 x light leaves thick fog dark grey)
+      // and mild forward scattering.
+      v.density *= 0.15f;
+      v.ambient = glm::vec3(0.6f, 0.65f, 0.75f);
+      v.anisotropy = 0.2f;
+    }
+  return volumes;
 }
 
 namespace {
@@ -107,7 +125,6 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
   const DemoView view;
   const DemoFrame frame = render_demo_scene(o.width, o.height, camera, view);
   VolumeScene scene;
-  scene.volumes = demo_volumes();
   scene.pose.eye = view.eye;
   scene.pose.forward = view.target - view.eye;
   scene.pose.up = glm::vec3(0.0f, 1.0f, 0.0f);
@@ -115,10 +132,11 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
   const ShadowMap shadow = render_demo_shadow_map();
 
   // The inputs of `fogcl apply --volumes` for these rows.
-  {
-    std::ofstream json(path("volumes.json"));
-    json << volumes_to_json(scene.volumes);
-    if (!json) throw Error(path("volumes.json") + ": write error");
+  for (const VolumeIntegrator i : {VolumeIntegrator::stylized, VolumeIntegrator::physical}) {
+    const std::string name = i == VolumeIntegrator::stylized ? "volumes.json" : "volumes-physical.json";
+    std::ofstream json(path(name));
+    json << volumes_to_json(demo_volumes(i));
+    if (!json) throw Error(path(name) + ": write error");
   }
   write_exr_depth(path("light-shadow.exr"), shadow.depth);
   std::ostringstream matrix;
@@ -130,27 +148,35 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
     txt << matrix.str() << "\n";
   }
 
-  std::printf("\nvolumetric fog volumes: %zu volumes, %d steps, half resolution, depth-aware; shadow map %dx%d\n",
-              scene.volumes.size(), VolumeSettings{}.steps, shadow.depth.width(), shadow.depth.height());
-  std::printf("(opencl: median of 5 runs after a warm-up; scalar: 1 run, the march is slow on one thread)\n");
+  std::printf(
+      "\nvolumetric fog volumes (volumes.json, volumes-physical.json): 4 volumes, %d steps, half resolution, "
+      "depth-aware; shadow map %dx%d\n",
+      VolumeSettings{}.steps, shadow.depth.width(), shadow.depth.height());
+  std::printf("(opencl: median of 3 runs after a warm-up; scalar: 1 run, the march is slow on one thread)\n");
   std::printf("%-26s %-8s %12s %14s\n", "setting", "path", "ms", "max err f64");
 
   std::map<const Runtime*, std::unique_ptr<VolumePass>> passes;
+  std::map<std::pair<int, bool>, VolumeResult<double>> refs;  // (integrator, shadow): rows share them
   for (const VolumeRow& row : kRows) {
     VolumeSettings settings;
     settings.integrator = row.integrator;
+    scene.volumes = demo_volumes(row.integrator);
     const ShadowMap* sm = row.shadow ? &shadow : nullptr;
     // Reference: the whole pass in double; with the deferred fog, its frame (rounded to float)
     // fogged by the double deferred path.
-    const VolumeResult<double> ref = volumes_scalar<double>(frame.color, frame.depth, frame.params, scene, settings, sm);
+    const std::pair<int, bool> key(int(row.integrator), row.shadow);
+    if (refs.count(key) == 0)
+      refs[key] = volumes_scalar<double>(frame.color, frame.depth, frame.params, scene, settings, sm);
+    const VolumeResult<double>& ref = refs[key];
     FogResult<double> ref_fog;
     if (row.deferred) {
       ColorImage mid(frame.color.width(), frame.color.height());
       for (int y = 0; y < mid.height(); ++y)
         for (int x = 0; x < mid.width(); ++x) {
           const std::size_t i = 4 * (std::size_t(y) * std::size_t(mid.width()) + std::size_t(x));
-          mid.set_pixel(x, y, glm::vec4(float(ref.rgba[i]), float(ref.rgba[i + 1]), float(ref.rgba[i + 2]),
-                                        float(ref.rgba[i + 3])));
+          mid.set_pixel(
+              x, y,
+              glm::vec4(float(ref.rgba[i]), float(ref.rgba[i + 1]), float(ref.rgba[i + 2]), float(ref.rgba[i + 3])));
         }
       ref_fog = fog_scalar<double>(mid, frame.depth, frame.params, deferred);
     }
@@ -173,7 +199,7 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
         ms.push_back(elapsed_ms(a));
       } else {
         run();  // warm-up: builds the variants, uploads the noise
-        for (int i = 0; i < 5; ++i) {
+        for (int i = 0; i < 3; ++i) {
           const auto a = std::chrono::steady_clock::now();
           run();
           ms.push_back(elapsed_ms(a));
@@ -188,14 +214,16 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
       write_png_preview(path(stem + ".png"), out);
     }
   }
-  std::printf("\nthe same with fogcl apply (volumes-stylized-shadow):\n  fogcl apply --color %s --depth %s --out OUT.exr "
-              "--near %g --far %g --fov %g --volumes %s --eye %s --forward %s --up %s --light-dir %s --light-color %s "
-              "--shadow-map %s --light-view-proj %s\n",
-              path("scene.exr").c_str(), path("scene-depth.exr").c_str(), double(camera.near_plane),
-              double(camera.far_plane), double(camera.fov_y_deg), path("volumes.json").c_str(),
-              vec(scene.pose.eye).c_str(), vec(scene.pose.forward).c_str(), vec(scene.pose.up).c_str(),
-              vec(scene.light.direction).c_str(), vec(scene.light.color).c_str(), path("light-shadow.exr").c_str(),
-              matrix.str().c_str());
+  std::printf(
+      "\nthe same with fogcl apply (volumes-stylized-shadow; physical: --integrator physical --volumes %s):\n  fogcl "
+      "apply --color %s --depth %s --out OUT.exr "
+      "--near %g --far %g --fov %g --volumes %s --eye %s --forward %s --up %s --light-dir %s --light-color %s "
+      "--shadow-map %s --light-view-proj %s\n",
+      path("volumes-physical.json").c_str(), path("scene.exr").c_str(), path("scene-depth.exr").c_str(),
+      double(camera.near_plane), double(camera.far_plane), double(camera.fov_y_deg), path("volumes.json").c_str(),
+      vec(scene.pose.eye).c_str(), vec(scene.pose.forward).c_str(), vec(scene.pose.up).c_str(),
+      vec(scene.light.direction).c_str(), vec(scene.light.color).c_str(), path("light-shadow.exr").c_str(),
+      matrix.str().c_str());
 }
 
 }  // namespace fogcl::cli

@@ -135,7 +135,8 @@ struct KeyReader {
 };
 
 FogVolume parse_volume(const json& j, const KeyReader& r) {
-  if (!j.is_object()) throw Error(r.where + "must be an object {\"center\": [x, y, z], \"radius\": r, ...} (got " + shown(j) + ")");
+  if (!j.is_object())
+    throw Error(r.where + "must be an object {\"center\": [x, y, z], \"radius\": r, ...} (got " + shown(j) + ")");
   if (!j.contains("center")) throw Error(r.where + "'center' is missing (every volume needs \"center\": [x, y, z])");
   if (!j.contains("radius")) throw Error(r.where + "'radius' is missing (every volume needs \"radius\": r > 0)");
   FogVolume v;
@@ -173,11 +174,11 @@ FogVolume parse_volume(const json& j, const KeyReader& r) {
 
 // The path of what the parser was reading when it failed, from the callback's key events.
 struct ParseContext {
-  std::string top_key;     // last key of the top-level object
-  std::string volume_key;  // last key of the current volume object
-  int volume = -1;         // index of the current volume object
+  std::string top_key;                      // last key of the top-level object
+  std::string volume_key;                   // last key of the current volume object
+  int volume = -1;                          // index of the current volume object
   std::vector<std::set<std::string>> keys;  // keys seen in each open object (duplicates)
-  std::string duplicate;   // "volume 1: duplicate key 'radius'"
+  std::string duplicate;                    // "volume 1: duplicate key 'radius'"
 
   std::string where() const {
     if (top_key == "volumes" && volume >= 0)
@@ -232,12 +233,14 @@ std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::st
     throw Error(name + ": " + ctx.where() + " must be a finite number (" + what + ")");
   }
   if (!ctx.duplicate.empty()) throw Error(name + ": " + ctx.duplicate);
-  if (!doc.is_object()) throw Error(name + ": the top level must be an object {\"volumes\": [...]} (got " + shown(doc) + ")");
+  if (!doc.is_object())
+    throw Error(name + ": the top level must be an object {\"volumes\": [...]} (got " + shown(doc) + ")");
   for (const auto& [key, value] : doc.items())
     if (key != "volumes") throw Error(name + ": top level: unknown key '" + key + "' (the only key is \"volumes\")");
   if (!doc.contains("volumes")) throw Error(name + ": top level: 'volumes' is missing (expected {\"volumes\": [...]})");
   const json& list = doc["volumes"];
-  if (!list.is_array()) throw Error(name + ": top level: 'volumes' must be an array of volume objects (got " + shown(list) + ")");
+  if (!list.is_array())
+    throw Error(name + ": top level: 'volumes' must be an array of volume objects (got " + shown(list) + ")");
   std::vector<FogVolume> volumes;
   for (std::size_t i = 0; i < list.size(); ++i) {
     volumes.push_back(parse_volume(list[i], KeyReader{name + ": volume " + std::to_string(i) + ": "}));
@@ -276,7 +279,9 @@ std::string volumes_to_json(const std::vector<FogVolume>& volumes) {
       std::visit(
           [&, key = key](auto m) {
             using T = std::remove_cv_t<std::remove_reference_t<decltype(v.*m)>>;
-            const auto v3 = [](const glm::vec3& a) { return json::array({shortest(a.x), shortest(a.y), shortest(a.z)}); };
+            const auto v3 = [](const glm::vec3& a) {
+              return json::array({shortest(a.x), shortest(a.y), shortest(a.z)});
+            };
             if constexpr (std::is_same_v<T, float>) j[key] = shortest(v.*m);
             if constexpr (std::is_same_v<T, bool>) j[key] = v.*m;
             if constexpr (std::is_same_v<T, glm::vec3>) j[key] = v3(v.*m);
@@ -315,17 +320,32 @@ glm::vec3 parse_vec3(const std::string& flag, const std::string& text) {
 }
 
 const std::map<std::string, VolumeIntegrator> kIntegrators{{"stylized", VolumeIntegrator::stylized},
-                                                            {"physical", VolumeIntegrator::physical}};
+                                                           {"physical", VolumeIntegrator::physical}};
 const std::map<std::string, int> kResolutions{{"full", 1}, {"half", 2}, {"quarter", 4}};
 const std::map<std::string, VolumeUpsampling> kUpsamplings{{"depth-aware", VolumeUpsampling::depth_aware},
                                                            {"bilinear", VolumeUpsampling::bilinear}};
-const std::map<std::string, NoiseSampling> kSamplings{{"buffer", NoiseSampling::buffer}, {"image", NoiseSampling::image}};
+const std::map<std::string, NoiseSampling> kSamplings{{"buffer", NoiseSampling::buffer},
+                                                      {"image", NoiseSampling::image}};
 
 // The flags that mean nothing without --volumes.
-const char* const kVolumeFlags[] = {"--eye", "--forward", "--up", "--light-dir", "--light-color", "--time", "--frame",
-                                    "--fps", "--integrator", "--steps", "--volume-resolution", "--upsample",
-                                    "--noise-size", "--noise-seed", "--noise-sampling", "--shadow-map",
-                                    "--light-view-proj", "--shadow-reversed-z"};
+const char* const kVolumeFlags[] = {"--eye",
+                                    "--forward",
+                                    "--up",
+                                    "--light-dir",
+                                    "--light-color",
+                                    "--time",
+                                    "--frame",
+                                    "--fps",
+                                    "--integrator",
+                                    "--steps",
+                                    "--volume-resolution",
+                                    "--upsample",
+                                    "--noise-size",
+                                    "--noise-seed",
+                                    "--noise-sampling",
+                                    "--shadow-map",
+                                    "--light-view-proj",
+                                    "--shadow-reversed-z"};
 
 bool given(const VolumeCliOptions& o, const std::string& flag) {
   return std::find(o.given.begin(), o.given.end(), flag) != o.given.end();
@@ -342,17 +362,20 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
                  "--mode may then be left out (off: only the volumes)")
       ->group(group);
   app.add_option("--eye", o.eye, "Camera position X,Y,Z [world units] (required with --volumes)")->group(group);
-  app.add_option("--forward", o.forward, "Camera view direction X,Y,Z, non-zero (required with --volumes)")->group(group);
+  app.add_option("--forward", o.forward, "Camera view direction X,Y,Z, non-zero (required with --volumes)")
+      ->group(group);
   app.add_option("--up", o.up, "Camera up X,Y,Z, not parallel to --forward (required with --volumes)")->group(group);
   app.add_option("--light-dir", o.light_dir, "Main light direction X,Y,Z, from the scene toward the light")
       ->capture_default_str()
       ->group(group);
-  app.add_option("--light-color", o.light_color, "Main light color, linear R,G,B >= 0")->capture_default_str()->group(group);
-  app.add_option("--time", o.time,
-                 "Noise scroll time [s] (default 0; sequences: frame number / --fps)")
+  app.add_option("--light-color", o.light_color, "Main light color, linear R,G,B >= 0")
+      ->capture_default_str()
       ->group(group);
+  app.add_option("--time", o.time, "Noise scroll time [s] (default 0; sequences: frame number / --fps)")->group(group);
   app.add_option("--frame", o.frame, "Jitter frame index >= 0 (default 0; sequences: the frame number)")->group(group);
-  app.add_option("--fps", o.fps, "Sequences: frames per second for the default --time, > 0")->capture_default_str()->group(group);
+  app.add_option("--fps", o.fps, "Sequences: frames per second for the default --time, > 0")
+      ->capture_default_str()
+      ->group(group);
   app.add_option("--integrator", o.integrator, "stylized (the seed's look) or physical (energy-conserving)")
       ->transform(CLI::IsMember(kIntegrators, CLI::ignore_case))
       ->capture_default_str()
@@ -366,7 +389,9 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
       ->transform(CLI::IsMember(kUpsamplings, CLI::ignore_case))
       ->capture_default_str()
       ->group(group);
-  app.add_option("--noise-size", o.noise_size, "Noise texels per side: 32, 64 or 128")->capture_default_str()->group(group);
+  app.add_option("--noise-size", o.noise_size, "Noise texels per side: 32, 64 or 128")
+      ->capture_default_str()
+      ->group(group);
   app.add_option("--noise-seed", o.noise_seed, "Noise seed, in [0, 4294967295]")->capture_default_str()->group(group);
   app.add_option("--noise-sampling", o.noise_sampling,
                  "buffer (trilinear in the kernel) or image (OpenCL 3D image, hardware filtering on GPUs)")
@@ -381,7 +406,8 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
                  "World -> light clip matrix, 16 numbers m00,m01,...,m33 row-major (the first four are the first "
                  "row); clip xy in [-1, 1] map to the shadow map's uv, clip z / w is its depth")
       ->group(group);
-  app.add_flag("--shadow-reversed-z", o.shadow_reversed_z, "The shadow map holds reversed Z (1 at the light's near plane)")
+  app.add_flag("--shadow-reversed-z", o.shadow_reversed_z,
+               "The shadow map holds reversed Z (1 at the light's near plane)")
       ->group(group);
 }
 
@@ -407,7 +433,8 @@ glm::mat4 parse_light_view_proj(const std::string& text) {
     start = comma + 1;
   }
   if (v.size() != 16)
-    throw Error("--light-view-proj must be 16 comma-separated numbers, row-major (got " + std::to_string(v.size()) + ")");
+    throw Error("--light-view-proj must be 16 comma-separated numbers, row-major (got " + std::to_string(v.size()) +
+                ")");
   glm::mat4 m(1.0f);
   for (int row = 0; row < 4; ++row)
     for (int col = 0; col < 4; ++col) {
@@ -467,13 +494,16 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
   }
   s.light_.direction = parse_vec3("--light-dir", o.light_dir);
   s.light_.color = parse_vec3("--light-color", o.light_color);
-  if (s.light_.direction == glm::vec3(0.0f)) throw Error("--light-dir must be a non-zero vector (got '" + o.light_dir + "')");
+  if (s.light_.direction == glm::vec3(0.0f))
+    throw Error("--light-dir must be a non-zero vector (got '" + o.light_dir + "')");
   for (int k = 0; k < 3; ++k)
-    if (s.light_.color[k] < 0.0f) throw Error("--light-color must be >= 0 in each channel (got '" + o.light_color + "')");
+    if (s.light_.color[k] < 0.0f)
+      throw Error("--light-color must be >= 0 in each channel (got '" + o.light_color + "')");
 
   if (!std::isfinite(o.time)) throw Error("--time must be finite (got " + str(o.time) + ")");
   if (!(std::isfinite(o.fps) && o.fps > 0.0)) throw Error("--fps must be finite and > 0 (got " + str(o.fps) + ")");
-  if (o.frame < 0 || o.frame > 4294967295LL) throw Error("--frame must be in [0, 4294967295] (got " + std::to_string(o.frame) + ")");
+  if (o.frame < 0 || o.frame > 4294967295LL)
+    throw Error("--frame must be in [0, 4294967295] (got " + std::to_string(o.frame) + ")");
 
   VolumeSettings& st = s.settings_;
   st.integrator = kIntegrators.at(o.integrator);
@@ -521,7 +551,9 @@ VolumeScene VolumeStage::scene_for(int sequence_frame) const {
   scene.light = light_;
   const bool sequence = sequence_frame >= 0;
   scene.frame_index = std::uint32_t(given(options_, "--frame") ? options_.frame : sequence ? sequence_frame : 0);
-  scene.time = float(given(options_, "--time") ? options_.time : sequence ? double(sequence_frame) / options_.fps : 0.0);
+  scene.time = float(given(options_, "--time") ? options_.time
+                     : sequence                ? double(sequence_frame) / options_.fps
+                                               : 0.0);
   return scene;
 }
 
@@ -535,10 +567,11 @@ void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImag
   if (!verbose) return;
   const std::size_t visible = visible_volumes(scene, camera, max_eye_depth(depth, camera)).size();
   const int s = settings_.resolution_divisor;
-  std::fprintf(stderr, "volumes: %zu of %zu visible (%s), %s integrator, %d steps, %s resolution (%dx%d target), %s upsampling\n",
-               visible, scene.volumes.size(), options_.volumes_path.c_str(), to_string(settings_.integrator),
-               settings_.steps, resolution_name(s), (in.width() + s - 1) / s, (in.height() + s - 1) / s,
-               to_string(settings_.upsampling));
+  std::fprintf(
+      stderr,
+      "volumes: %zu of %zu visible (%s), %s integrator, %d steps, %s resolution (%dx%d target), %s upsampling\n",
+      visible, scene.volumes.size(), options_.volumes_path.c_str(), to_string(settings_.integrator), settings_.steps,
+      resolution_name(s), (in.width() + s - 1) / s, (in.height() + s - 1) / s, to_string(settings_.upsampling));
   std::fprintf(stderr, "  noise: %d^3 texels, seed %u, %s sampling; shadow map: %s\n", settings_.noise_size,
                unsigned(settings_.noise_seed), to_string(settings_.noise_sampling),
                shadow_ ? (std::to_string(shadow_->depth.width()) + "x" + std::to_string(shadow_->depth.height()) +
@@ -546,16 +579,20 @@ void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImag
                              .c_str()
                        : "none (no shadow term)");
   std::fprintf(stderr, "  frame index %u%s, time %g s%s\n", unsigned(scene.frame_index),
-               given(options_, "--frame") ? " (--frame)" : sequence_frame >= 0 ? " (the frame number)" : " (default)",
+               given(options_, "--frame") ? " (--frame)"
+               : sequence_frame >= 0      ? " (the frame number)"
+                                          : " (default)",
                double(scene.time),
-               given(options_, "--time") ? " (--time)" : sequence_frame >= 0 ? " (frame number / --fps)" : " (default)");
+               given(options_, "--time") ? " (--time)"
+               : sequence_frame >= 0     ? " (frame number / --fps)"
+                                         : " (default)");
   if (!pass_)
     std::fprintf(stderr, "  path: scalar C++ in float (no build options)\n");
   else if (pass_->last_march_options().empty())
     std::fprintf(stderr, "  no volume visible: no dispatch, the volumes leave the frame as it was\n");
   else
-    std::fprintf(stderr, "  march build options: %s\n  composite build options: %s\n", pass_->last_march_options().c_str(),
-                 pass_->last_composite_options().c_str());
+    std::fprintf(stderr, "  march build options: %s\n  composite build options: %s\n",
+                 pass_->last_march_options().c_str(), pass_->last_composite_options().c_str());
 }
 
 }  // namespace fogcl::cli

@@ -22,18 +22,17 @@ namespace fogcl::cli {
 
 // The volume flags as given (vectors as text "X,Y,Z", parsed with messages that name the flag).
 struct VolumeCliOptions {
-  std::string volumes_path;                 // --volumes: "" = no volumetric pass
-  std::string eye, forward, up;             // required with --volumes
+  std::string volumes_path;      // --volumes: "" = no volumetric pass
+  std::string eye, forward, up;  // required with --volumes
   std::string light_dir = "0,1,0", light_color = "1,1,1";
-  double time = 0.0;                        // --time [s]
-  long long frame = 0;                      // --frame: jitter seed
-  double fps = 24.0;                        // sequences: default time = frame number / fps
-  std::string integrator = "stylized", resolution = "half", upsample = "depth-aware",
-              noise_sampling = "buffer";
+  double time = 0.0;    // --time [s]
+  long long frame = 0;  // --frame: jitter seed
+  double fps = 24.0;    // sequences: default time = frame number / fps
+  std::string integrator = "stylized", resolution = "half", upsample = "depth-aware", noise_sampling = "buffer";
   long long steps = 50, noise_size = 64, noise_seed = 1;
   std::string shadow_map_path, light_view_proj;
   bool shadow_reversed_z = false;
-  std::vector<std::string> given;           // the volume flags on the command line
+  std::vector<std::string> given;  // the volume flags on the command line
 };
 
 // Registers the volume flags on `fogcl apply`.
@@ -92,7 +91,7 @@ class VolumeStage {
 // backend after the deferred ones; `deferred` is the fog of the row that runs both passes.
 struct DemoOptions;
 class Backend;
-std::vector<FogVolume> demo_volumes();
+std::vector<FogVolume> demo_volumes(VolumeIntegrator integrator);
 void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>& backends,
                       const FogSettings& deferred);
 
