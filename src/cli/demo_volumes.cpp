@@ -19,71 +19,6 @@
 
 namespace fogcl::cli {
 
-std::vector<FogVolume> demo_volumes(VolumeIntegrator integrator) {
-  // Noise tiling 0.1-0.25 per world unit: one noise period spans 4-10 units, a few billows per
-  // volume in this ~50-unit scene (the seed's 0.015 suits its 100s-of-units scenes). Fades of a
-  // few units (the seed's 20 / 10 would thin these 3-12 unit spheres to nothing), and a cut-off
-  // that leaves gaps between the billows. Values chosen by looking at the PNGs.
-  FogVolume around;  // the camera (0, 1.6, -6) is inside: a light haze with gaps
-  around.center = glm::vec3(0.5f, 1.5f, -4.0f);
-  around.radius = 6.0f;
-  around.density = 1.2f;
-  around.fade_edge = 1.5f;
-  around.proximity_fade = 0.5f;
-  around.fog_cutoff = 0.5f;
-  around.tiling = glm::vec3(0.2f);
-  around.detail_tiling = glm::vec3(0.6f);
-  around.detail_strength = 0.4f;
-  around.speed = glm::vec3(0.6f, -0.1f, 0.3f);
-  around.fog_color = glm::vec4(0.9f, 0.92f, 1.0f, 1.0f);
-
-  FogVolume behind = around;  // behind the (2.2, 1, -0.5) sphere, seen past its silhouette
-  behind.center = glm::vec3(3.2f, 1.8f, 3.5f);
-  behind.radius = 3.5f;
-  behind.density = 4.0f;
-  behind.fade_edge = 1.0f;
-  behind.fog_cutoff = 0.35f;
-  behind.tiling = glm::vec3(0.25f);
-  behind.detail_tiling = glm::vec3(0.7f);
-  behind.fog_color = glm::vec4(1.0f, 0.7f, 0.45f, 1.0f);
-
-  FogVolume ground = around;  // crossing the ground, thinning out with height
-  ground.center = glm::vec3(-5.0f, 0.0f, 12.0f);
-  ground.radius = 7.0f;
-  ground.max_y = 5.0f;
-  ground.fade_y = 3.0f;
-  ground.density = 6.0f;
-  ground.fog_cutoff = 0.25f;
-  ground.tiling = glm::vec3(0.15f);
-  ground.detail_tiling = glm::vec3(0.5f);
-  ground.fog_color = glm::vec4(0.55f, 0.7f, 1.0f, 1.0f);
-
-  FogVolume bank = around;  // a wide bank around the far spheres
-  bank.center = glm::vec3(4.0f, 2.0f, 34.0f);
-  bank.radius = 12.0f;
-  bank.max_y = 7.0f;
-  bank.fade_y = 4.0f;
-  bank.fade_edge = 3.0f;
-  bank.proximity_fade = 1.0f;
-  bank.density = 6.0f;
-  bank.fog_cutoff = 0.3f;
-  bank.tiling = glm::vec3(0.1f);
-  bank.detail_tiling = glm::vec3(0.3f);
-  bank.fog_color = glm::vec4(0.85f, 0.9f, 1.0f, 1.0f);
-
-  std::vector<FogVolume> volumes{around, behind, ground, bank};
-  if (integrator == VolumeIntegrator::physical)
-    for (FogVolume& v : volumes) {
-      // density is then sigma_t [1/unit]: 0.15 x the stylized alpha scale keeps the thick parts
-      // translucent; a sky-coloured ambient (the seed's 0.1 x light leaves thick fog dark grey)
-      // and mild forward scattering.
-      v.density *= 0.15f;
-      v.ambient = glm::vec3(0.6f, 0.65f, 0.75f);
-      v.anisotropy = 0.2f;
-    }
-  return volumes;
-}
-
 namespace {
 
 double elapsed_ms(std::chrono::steady_clock::time_point a) {
@@ -135,7 +70,7 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
   for (const VolumeIntegrator i : {VolumeIntegrator::stylized, VolumeIntegrator::physical}) {
     const std::string name = i == VolumeIntegrator::stylized ? "volumes.json" : "volumes-physical.json";
     std::ofstream json(path(name));
-    json << volumes_to_json(demo_volumes(i));
+    json << volumes_to_json(demo_fog_volumes(i));
     if (!json) throw Error(path(name) + ": write error");
   }
   write_exr_depth(path("light-shadow.exr"), shadow.depth);
@@ -160,7 +95,7 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
   for (const VolumeRow& row : kRows) {
     VolumeSettings settings;
     settings.integrator = row.integrator;
-    scene.volumes = demo_volumes(row.integrator);
+    scene.volumes = demo_fog_volumes(row.integrator);
     const ShadowMap* sm = row.shadow ? &shadow : nullptr;
     // Reference: the whole pass in double; with the deferred fog, its frame (rounded to float)
     // fogged by the double deferred path.

@@ -87,11 +87,10 @@ class VolumeStage {
   std::unique_ptr<VolumePass> pass_;  // null: scalar
 };
 
-// `fogcl demo`'s volumetric rows (cli/demo_volumes.cpp): its fog volumes, and the rows run on each
+// `fogcl demo`'s volumetric rows (cli/demo_volumes.cpp): demo_fog_volumes() run on each
 // backend after the deferred ones; `deferred` is the fog of the row that runs both passes.
 struct DemoOptions;
 class Backend;
-std::vector<FogVolume> demo_volumes(VolumeIntegrator integrator);
 void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>& backends,
                       const FogSettings& deferred);
 

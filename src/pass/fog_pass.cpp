@@ -6,6 +6,7 @@
 #include "deferred_fog_cl.h"
 #include "fogcl/error.h"
 #include "runtime/clhpp.h"
+#include "runtime/frame_buffers.h"
 #include "settings/fog_coefficients.h"
 
 namespace fogcl {
@@ -14,29 +15,6 @@ namespace {
 cl_float4 f4(float x, float y, float z, float w) { return cl_float4{{x, y, z, w}}; }
 cl_float4 f4(const glm::vec4& v) { return f4(v.x, v.y, v.z, v.w); }
 cl_float4 f4(const glm::vec3& v) { return f4(v.x, v.y, v.z, 0.0f); }
-
-std::string frame_text(int width, int height, ColorFormat format) {
-  return std::to_string(width) + "x" + std::to_string(height) + " " + to_string(format);
-}
-
-// Exact size (docs/DESIGN.md §1.1): a larger buffer is legal OpenCL but, for a packed frame, means
-// a wrong format or size; `other_format_bytes` names the likely mistake.
-void check_buffer(cl_mem buffer, const char* name, const cl::Context& context, std::size_t needed,
-                  const std::string& frame, std::size_t other_format_bytes, ColorFormat other_format) {
-  if (buffer == nullptr) throw Error(std::string("frame buffer ") + name + " is not set (null cl_mem)");
-  const cl::Buffer b = wrap(buffer);
-  if (b.getInfo<CL_MEM_CONTEXT>()() != context())
-    throw Error(std::string("frame buffer ") + name + " belongs to another OpenCL context than the pass");
-  const std::size_t size = b.getInfo<CL_MEM_SIZE>();
-  if (size == needed) return;
-  std::string msg = std::string("frame buffer ") + name + " holds " + std::to_string(size) + " bytes but a " +
-                    frame + " frame needs exactly " + std::to_string(needed) +
-                    " (frames are packed and buffers exact-size; use a sub-buffer for part of a larger one)";
-  if (other_format_bytes != 0 && size == other_format_bytes)
-    msg += std::string(": that is the size of a ") + to_string(other_format) +
-           " frame, is FrameBuffers::format right?";
-  throw Error(msg);
-}
 }  // namespace
 
 std::size_t color_buffer_bytes(int width, int height, ColorFormat format) {
@@ -136,7 +114,6 @@ bool FogPass::is_prepared(const Variant& variant) const {
 cl_event FogPass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
                           const FogSettings& settings, const std::vector<cl_event>& wait_list) {
   Impl& m = *impl_;
-  if (queue_handle == nullptr) throw Error("FogPass::enqueue: the queue is null");
   if (fb.width < 1 || fb.height < 1)
     throw Error("frame size must be at least 1x1 (got " + std::to_string(fb.width) + "x" +
                 std::to_string(fb.height) + ")");
@@ -144,18 +121,8 @@ cl_event FogPass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb,
   const Variant v = select_variant(settings, camera, fb.format);
   const std::size_t color_bytes = color_buffer_bytes(fb.width, fb.height, fb.format);
   return with_cl_errors([&] {
-    const cl::CommandQueue queue = wrap(queue_handle);
-    if (queue.getInfo<CL_QUEUE_CONTEXT>()() != m.context())
-      throw Error("FogPass::enqueue: the queue belongs to another OpenCL context than the pass");
-    if (queue.getInfo<CL_QUEUE_DEVICE>()() != m.device())
-      throw Error("FogPass::enqueue: the queue is on another device than the pass (" +
-                  device_name(queue.getInfo<CL_QUEUE_DEVICE>()()) + ", pass: " + device_name(m.device()) + ")");
-    const std::string frame = frame_text(fb.width, fb.height, fb.format);
-    const ColorFormat other = fb.format == ColorFormat::rgba32f ? ColorFormat::rgba16f : ColorFormat::rgba32f;
-    const std::size_t other_bytes = color_buffer_bytes(fb.width, fb.height, other);
-    check_buffer(fb.color_in, "color_in", m.context, color_bytes, frame, other_bytes, other);
-    check_buffer(fb.depth, "depth", m.context, depth_buffer_bytes(fb.width, fb.height), frame, 0, other);
-    check_buffer(fb.color_out, "color_out", m.context, color_bytes, frame, other_bytes, other);
+    const cl::CommandQueue queue = detail::checked_queue(queue_handle, m.context, m.device, "FogPass::enqueue");
+    detail::check_frame_buffers(fb, m.context);
     cl::Kernel* kernel = v.needs_pass() ? m.find_kernel(v) : nullptr;
     if (v.needs_pass() && kernel == nullptr)
       throw Error("fog variant '" + describe(v) + "' is not prepared: call FogPass::prepare(settings, camera, " +
@@ -215,40 +182,14 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
   prepare(v);  // apply blocks anyway: the one place that builds on demand
   with_cl_errors([&] {
     if (m.queue() == nullptr) m.queue = cl::CommandQueue(m.context, m.device, CL_QUEUE_PROFILING_ENABLE);
-    const cl::Context& ctx = m.context;
     // CPU devices read and write the host images where they are (page-aligned storage);
     // other devices get copies.
-    const cl_mem_flags host = m.traits.cpu ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
-    void* in_ptr = const_cast<void*>(in.data());
-    const cl::Buffer depth_buffer(ctx, CL_MEM_READ_ONLY | host, depth.size_bytes(), const_cast<float*>(depth.data()));
-    cl::Buffer color_in, color_out;
-    if (in_place) {
-      color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | host, in.size_bytes(), in_ptr);
-      color_out = color_in;
-    } else {
-      color_in = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, in.size_bytes(), in_ptr);
-      color_out = m.traits.cpu ? cl::Buffer(ctx, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out.size_bytes(), out.data())
-                               : cl::Buffer(ctx, CL_MEM_WRITE_ONLY, out.size_bytes());
-    }
-    FrameBuffers fb;
-    fb.width = in.width();
-    fb.height = in.height();
-    fb.format = in.format();
-    fb.color_in = color_in();
-    fb.depth = depth_buffer();
-    fb.color_out = color_out();
-    const std::vector<cl::Event> after{adopt(enqueue(m.queue(), fb, camera, settings))};
-    if (m.traits.cpu) {
-      // Mapping is what makes a USE_HOST_PTR buffer's contents valid in host memory; on a CPU
-      // device it returns the same pointer and copies nothing.
-      void* mapped = m.queue.enqueueMapBuffer(color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes(), &after);
-      m.queue.enqueueUnmapMemObject(color_out, mapped);
-      m.queue.finish();
+    const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
+    const cl::Event done = adopt(enqueue(m.queue(), frame.raw, camera, settings));
+    if (detail::read_back(m.queue, m.traits.cpu, frame, done, out))
       ++m.stats.zero_copy_frames;
-    } else {
-      m.queue.enqueueReadBuffer(color_out, CL_TRUE, 0, out.size_bytes(), out.data(), &after);
+    else
       ++m.stats.copied_frames;
-    }
   });
 }
 
