@@ -43,7 +43,7 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL key, VOL_GLOBAL const VOL_REAL
   return sum / weight;
 }
 
-/* One channel over the fog (DESIGN §5.4): P + c (1 - A). A == 1 writes P exactly (a hidden
+/* One channel over the fog (docs/volumetric.md §Resolution, upsampling, composite): P + c (1 - A). A == 1 writes P exactly (a hidden
  * NaN/Inf never leaks); the caller passes A == 0 pixels through bit for bit. */
 VOL_FN VOL_REAL vol_composite(VOL_REAL c, VOL_REAL premultiplied, VOL_REAL coverage) {
   return coverage == (VOL_REAL)1 ? premultiplied : premultiplied + c * ((VOL_REAL)1 - coverage);

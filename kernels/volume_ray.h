@@ -4,7 +4,7 @@
 
 /* Projections, as fog_math.h numbers them (FOG_PROJECTION_*). */
 
-/* Eye depth (view z) of a raw depth sample, +inf for sky (DESIGN §2's sky test; raw 0 with an
+/* Eye depth (view z) of a raw depth sample, +inf for sky (docs/DESIGN.md §2's sky test; raw 0 with an
  * infinite far plane). NaN and out-of-range depths are sanitised as in the deferred pass. */
 VOL_FN VOL_REAL vol_eye_depth(VOL_REAL raw, int projection, int reversed_z, VOL_REAL zx, VOL_REAL zy,
                               VOL_REAL near_plane, VOL_REAL far_plane) {
@@ -60,7 +60,7 @@ VOL_FN void vol_pixel_ray(VOL_REAL px, VOL_REAL py, VOL_GLOBAL const float* fram
   *t_per_eye = length(VOL_MAKE3(c[0], c[1], c[2])) / corner_z;
 }
 
-/* Distance along the ray from its origin to the depth buffer's surface (DESIGN §5.1): exact,
+/* Distance along the ray from its origin to the depth buffer's surface (docs/volumetric.md §World and rays): exact,
  * where the seed compares with lerp(near, far, Linear01Depth), off by the ray's angle. */
 VOL_FN VOL_REAL vol_scene_distance(VOL_REAL eye_depth, VOL_REAL near_plane, VOL_REAL t_per_eye) {
   if (!(eye_depth < (VOL_REAL)INFINITY)) return (VOL_REAL)INFINITY;

@@ -262,7 +262,7 @@ TEST(ScalarRows, BandsGiveTheBitsOfOneCall) {
 }
 
 // Half in, half out: every pixel with f == 1 (sky, unfogged) keeps its 16 bits, NaN payloads,
-// signalling NaNs, -0 and subnormals included; alpha keeps its bits everywhere (DESIGN.md §2).
+// signalling NaNs, -0 and subnormals included; alpha keeps its bits everywhere (docs/DESIGN.md §2).
 TEST_F(Sequence, HalfOutputOfHalfInputKeepsUnfoggedPixelsBitForBit) {
   const int w = 16, h = 8;
   const std::uint16_t specials[] = {0x7c01, 0x7e2a, 0xfe01, 0x8000, 0x0001, 0x83ff, 0x7c00, 0xfc00, 0x7bff, 0x3c00};

@@ -1,4 +1,4 @@
-// The volumetric pass's noise texture (fogcl/noise.h, DESIGN.md §5.2): it tiles (opposite faces
+// The volumetric pass's noise texture (fogcl/noise.h, docs/volumetric-noise.md): it tiles (opposite faces
 // continue each other), fills [0, 1] in every channel, each channel has the frequency it claims,
 // and it is deterministic from (size, seed). Every test prints what it measured, passing or not.
 #include <algorithm>

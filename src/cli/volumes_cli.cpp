@@ -356,7 +356,7 @@ const char* resolution_name(int divisor) { return divisor == 1 ? "full" : diviso
 }  // namespace
 
 void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
-  const char* group = "Volumetric fog volumes (DESIGN.md §5; run before the deferred fog)";
+  const char* group = "Volumetric fog volumes (docs/volumetric.md; run before the deferred fog)";
   app.add_option("--volumes", o.volumes_path,
                  "VOLUMES.json: {\"volumes\": [{\"center\": [x,y,z], \"radius\": r, ...}]} (README 'VOLUMES.json'); "
                  "--mode may then be left out (off: only the volumes)")

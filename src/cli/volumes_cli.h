@@ -1,4 +1,4 @@
-// `fogcl apply --volumes`: the volumetric fog volumes pass (DESIGN.md §5) in the CLI. Kept apart
+// `fogcl apply --volumes`: the volumetric fog volumes pass (docs/volumetric.md) in the CLI. Kept apart
 // from apply.cpp, which only registers the flags (add_volume_options), builds a VolumeStage once
 // per run and calls VolumeStage::apply on each frame before the deferred fog.
 #pragma once

@@ -1,4 +1,4 @@
-// The volumetric pass's noise (DESIGN.md §5.2; docs/volumetric-noise.md): one tileable 3D texture
+// The volumetric pass's noise (docs/volumetric.md §A volume; docs/volumetric-noise.md): one tileable 3D texture
 // of N^3 texels, 4 channels, generated on the host from (size, seed) and uploaded once per device.
 //
 //   R  gradient-noise fBm (Perlin 2002, "Improving Noise": 12 cube-edge gradients, quintic fade
