@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <limits>
 #include <tuple>
 
 #include "volume_support.h"
@@ -23,11 +25,13 @@ struct VariantCase {
   ColorFormat storage;
 };
 
-class VolumeKernelVsReference : public ::testing::TestWithParam<std::tuple<VolumeIntegrator, bool, int, ColorFormat>> {};
+// integrator x noise x shadow map x resolution x storage.
+class VolumeKernelVsReference
+    : public ::testing::TestWithParam<std::tuple<VolumeIntegrator, bool, bool, int, ColorFormat>> {};
 
 TEST_P(VolumeKernelVsReference, WithinBudget) {
   FOGCL_REQUIRE_DEVICE();
-  const auto [integrator, noise, divisor, storage] = GetParam();
+  const auto [integrator, noise, shadowed, divisor, storage] = GetParam();
   VolumeTestScene t = volume_test_scene(96, 54, storage);
   for (FogVolume& v : t.scene.volumes) v.noise = noise;
   VolumeSettings settings;
@@ -35,14 +39,16 @@ TEST_P(VolumeKernelVsReference, WithinBudget) {
   settings.resolution_divisor = divisor;
   settings.steps = 32;
   t.scene.frame_index = 7;
+  const ShadowMap shadow = synthetic_shadow_map(false);
+  const ShadowMap* map = shadowed ? &shadow : nullptr;
   ColorImage out;
-  volume_pass().apply(t.frame.color, t.frame.depth, out, t.frame.params, t.scene, settings);
+  volume_pass().apply(t.frame.color, t.frame.depth, out, t.frame.params, t.scene, settings, map);
   const VolumeResult<double> ref =
-      volumes_scalar<double>(t.frame.color, t.frame.depth, t.frame.params, t.scene, settings);
+      volumes_scalar<double>(t.frame.color, t.frame.depth, t.frame.params, t.scene, settings, map);
   const double tolerance = storage == ColorFormat::rgba16f ? 4e-3 : 2e-4;
   const VolumeErrorStats s = compare_volumes(out, ref, tolerance);
-  std::printf("  %s noise %d 1/%d %s: %s\n", to_string(integrator), int(noise), divisor, to_string(storage),
-              describe(s).c_str());
+  std::printf("  %s noise %d shadow %d 1/%d %s: %s\n", to_string(integrator), int(noise), int(shadowed), divisor,
+              to_string(storage), describe(s).c_str());
   EXPECT_GT(s.fogged, s.pixels / 10);
   EXPECT_EQ(s.nonfinite, 0u);
   EXPECT_LE(s.over, s.pixels / 1000) << describe(s);
@@ -95,8 +101,64 @@ INSTANTIATE_TEST_SUITE_P(Features, VolumeKernelFeatures,
 
 INSTANTIATE_TEST_SUITE_P(Variants, VolumeKernelVsReference,
                          ::testing::Combine(::testing::Values(VolumeIntegrator::stylized, VolumeIntegrator::physical),
-                                            ::testing::Bool(), ::testing::Values(1, 2, 4),
+                                            ::testing::Bool(), ::testing::Bool(), ::testing::Values(1, 2, 4),
                                             ::testing::Values(ColorFormat::rgba32f, ColorFormat::rgba16f)));
+
+// docs/DESIGN.md §2's NaN rules in the composite: coverage 0 keeps the pixel's bits (NaN, Inf,
+// signalling NaN), coverage 1 writes the fog exactly, so a hidden NaN/Inf never leaks; finite
+// inputs never give a non-finite output. An opaque physical volume (sigma_t 1e20: A = 1) covers
+// the frame's centre; the colors hold NaN and Inf everywhere.
+class VolumeComposite : public ::testing::TestWithParam<ColorFormat> {};
+
+TEST_P(VolumeComposite, FollowsTheNanRules) {
+  FOGCL_REQUIRE_DEVICE();
+  const ColorFormat storage = GetParam();
+  VolumeTestScene t = volume_test_scene(64, 36, storage);
+  FogVolume opaque;
+  opaque.center = t.scene.pose.eye + 8.0f * glm::normalize(t.scene.pose.forward);
+  opaque.radius = 2.0f;
+  opaque.density = 1e20f;
+  opaque.noise = false;
+  opaque.fade_edge = opaque.fade_y = opaque.proximity_fade = 0.0f;
+  opaque.max_y = 1e6f;
+  t.scene.volumes = {opaque};
+  for (int y = 0; y < 36; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float bad[3] = {std::numeric_limits<float>::quiet_NaN(), INFINITY, -INFINITY};
+      glm::vec4 c = t.frame.color.pixel(x, y);
+      c[(x + y) % 3] = bad[(x * 7 + y) % 3];
+      t.frame.color.set_pixel(x, y, c);
+    }
+  VolumeSettings settings;
+  settings.integrator = VolumeIntegrator::physical;
+  settings.resolution_divisor = 1;
+  ColorImage out;
+  volume_pass().apply(t.frame.color, t.frame.depth, out, t.frame.params, t.scene, settings);
+  const VolumeResult<double> ref = volumes_scalar<double>(t.frame.color, t.frame.depth, t.frame.params, t.scene, settings);
+  const std::size_t bpp = bytes_per_pixel(storage);
+  std::size_t covered = 0, clear = 0, wrong = 0;
+  for (int y = 0; y < 36; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const std::size_t i = std::size_t(y) * 64 + x;
+      const auto* a = static_cast<const unsigned char*>(out.data()) + i * bpp;
+      const auto* b = static_cast<const unsigned char*>(t.frame.color.data()) + i * bpp;
+      if (ref.coverage[i] == 0.0) {
+        ++clear;
+        wrong += std::memcmp(a, b, bpp) != 0;
+      } else if (ref.coverage[i] == 1.0) {
+        ++covered;
+        const glm::vec4 o = out.pixel(x, y);
+        for (int k = 0; k < 3; ++k) wrong += !std::isfinite(o[k]) || std::fabs(o[k] - ref.rgba[4 * i + k]) > 1e-3;
+      }
+    }
+  std::printf("  %s: %zu covered pixels (A = 1), %zu clear (A = 0), %zu wrong\n", to_string(storage), covered, clear,
+              wrong);
+  EXPECT_GT(covered, 20u);
+  EXPECT_GT(clear, 200u);
+  EXPECT_EQ(wrong, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Storage, VolumeComposite, ::testing::Values(ColorFormat::rgba32f, ColorFormat::rgba16f));
 
 }  // namespace
 }  // namespace fogcl::test
