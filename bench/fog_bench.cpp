@@ -7,12 +7,17 @@
 //   BM_OpenMPSimd        the OpenMP + SIMD C++ peer (-O3 -march=native, 2 threads)
 //   BM_OpenMPSimdFastMath  the same with -ffast-math (vectorised exp2; no NaN/Inf guarantees)
 //   BM_OpenCLDevice      the OpenCL pass, zero-copy buffers, device time from profiling events
-//   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish)
+//   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish); on a
+//                        GPU the host round trip: upload + kernel + download
+//   BM_DeviceCopy        clEnqueueCopyBuffer of the pass's color and depth into device buffers
+//                        (profiling events): the device's own bandwidth ceiling, for GPUs
 //   BM_OpenCLDeviceCacheResident  BM_OpenCLDevice on a 512x256 frame that stays in the caches
 //                        (its compute cost; BM_Memcpy also runs at 512x256)
 // Counters: bytes_per_second; vs_memcpy2 = (2-thread memcpy time of the same bytes, measured
 // interleaved with this benchmark's iterations: memcpy2_ms) / (this time); ns_per_16px; max_err =
-// max |color - float64 path| (speed always comes with its error).
+// max |color - float64 path| (speed always comes with its error). BM_OpenCLDevice also times a
+// device-side copy of color and depth after each iteration (outside its timing): copy_ms, and
+// bw_vs_copy = (pass bytes / pass time) / (copied bytes read + written / copy time).
 // BM_OpticalDepth: exp fog at density * d ~ 1, 1e2 (denormal factors), 1e3, 1e20.
 // Start-up: BM_ProgramBuild (cold: a never-seen option string; warm: PoCL's disk cache),
 // BM_FirstDispatch, BM_DispatchOverhead (1x1 frame), BM_StartToFirstFrame (whole process path:
@@ -88,6 +93,41 @@ double memcpy2_seconds(const DemoFrame& f) {
   return t[t.size() / 2];
 }
 
+// clEnqueueCopyBuffer of a frame's color and depth into scratch buffers of the same device: the
+// device's copy bandwidth over the bytes the pass touches. Buffers live in device memory (no host
+// pointer), as a renderer's own buffers do.
+class DeviceCopy {
+ public:
+  DeviceCopy(const cl::Context& ctx, const DemoFrame& f)
+      : color_bytes_(f.color.size_bytes()), depth_bytes_(f.depth.size_bytes()),
+        color_in_(ctx, CL_MEM_READ_WRITE, color_bytes_), color_out_(ctx, CL_MEM_READ_WRITE, color_bytes_),
+        depth_in_(ctx, CL_MEM_READ_WRITE, depth_bytes_), depth_out_(ctx, CL_MEM_READ_WRITE, depth_bytes_) {}
+
+  // Seconds from the first copy's start to the second's end (profiling events).
+  double seconds(const cl::CommandQueue& queue) const {
+    cl::Event a, b;
+    queue.enqueueCopyBuffer(color_in_, color_out_, 0, 0, color_bytes_, nullptr, &a);
+    queue.enqueueCopyBuffer(depth_in_, depth_out_, 0, 0, depth_bytes_, nullptr, &b);
+    b.wait();
+    return double(b.getProfilingInfo<CL_PROFILING_COMMAND_END>() - a.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
+  }
+
+  // Bytes a copy reads and writes.
+  std::size_t bytes_moved() const { return 2 * (color_bytes_ + depth_bytes_); }
+
+ private:
+  std::size_t color_bytes_, depth_bytes_;
+  cl::Buffer color_in_, color_out_, depth_in_, depth_out_;
+};
+
+// One DeviceCopy per frame, kept across benchmark runs (4K buffers are 330 MB of device memory).
+const DeviceCopy& device_copy(const cl::Context& ctx, const DemoFrame& f) {
+  static std::map<const DemoFrame*, std::unique_ptr<DeviceCopy>> copies;
+  auto& c = copies[&f];
+  if (!c) c = std::make_unique<DeviceCopy>(ctx, f);
+  return *c;
+}
+
 struct Case {
   int w, h;
   FogSettings settings;
@@ -144,8 +184,10 @@ double host_time(const std::function<void()>& fn) {
 }
 
 // path: names the benchmark, so that its error is measured once across repetitions.
+// interleave_memcpy: false for a GPU's device-time benchmark, whose ceiling is the device's own
+// copy (the host memcpy is then measured once, after the loop).
 template <class Run>
-void timed_fog(benchmark::State& state, const char* path, Run&& run) {
+void timed_fog(benchmark::State& state, const char* path, Run&& run, bool interleave_memcpy = true) {
   const Case c = case_of(state);
   const DemoFrame& f = frame(c.w, c.h, c.format);
   ColorImage out(f.color.width(), f.color.height(), f.color.format());
@@ -163,10 +205,10 @@ void timed_fog(benchmark::State& state, const char* path, Run&& run) {
     const double s = run(f, out, c.settings);
     state.SetIterationTime(s);
     total += s;
-    copies += host_time([&] { copy_bytes(f, copy_out, copy_depth, 2); });  // manual time: not counted
+    if (interleave_memcpy) copies += host_time([&] { copy_bytes(f, copy_out, copy_depth, 2); });  // not counted
   }
   const double n = double(state.iterations());
-  finish(state, f, total / n, copies / n);
+  finish(state, f, total / n, interleave_memcpy ? copies / n : memcpy2_seconds(f));
   // Every path is deterministic: measure its error once per benchmark, not per repetition.
   static std::map<std::string, double> errors;
   std::string key = path;
@@ -220,6 +262,11 @@ void BM_OpenCLDevice(benchmark::State& state) {
   if (rt == nullptr) return;
   FogPass& pass = shared_pass(*rt, state.range(5) != 0);
   const cl_mem_flags host = rt->is_cpu() ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
+  const Case c = case_of(state);
+  const DemoFrame& frame_in = frame(c.w, c.h, c.format);
+  const DeviceCopy& copy = device_copy(wrap(rt->context()), frame_in);
+  double pass_s = 0, copy_s = 0;
+  bool read_back = false;
   timed_fog(state, state.range(5) ? "opencl-device-nt" : "opencl-device", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     // Buffers wrap the same host memory every time (created once per frame and output).
     // The cl::Buffers own the handles; FrameBuffers borrows them.
@@ -228,7 +275,8 @@ void BM_OpenCLDevice(benchmark::State& state) {
       FrameBuffers fb;
     };
     static std::map<std::tuple<const void*, const void*, const FogPass*>, Buffers> buffers;
-    auto key = std::make_tuple(f.color.data(), static_cast<const void*>(out.data()), &pass);
+    // On a CPU the output wraps `out` (new each run); a GPU's buffers are its own, one set per frame.
+    auto key = std::make_tuple(f.color.data(), rt->is_cpu() ? static_cast<const void*>(out.data()) : nullptr, &pass);
     auto it = buffers.find(key);
     const cl::Context ctx = wrap(rt->context());
     const cl::CommandQueue queue = wrap(rt->queue());
@@ -249,13 +297,34 @@ void BM_OpenCLDevice(benchmark::State& state) {
     }
     const cl::Event e = adopt(pass.enqueue(rt->queue(), it->second.fb, f.params, s));
     e.wait();
-    if (!rt->is_cpu())
-      queue.enqueueReadBuffer(it->second.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
-    else  // make the host view of the USE_HOST_PTR output valid (no copy on CPU devices)
+    copy_s += copy.seconds(queue);  // the ceiling, interleaved, outside the pass's time
+    if (!rt->is_cpu()) {  // the result, for the error, once per run: a 4K read-back is ~10 ms
+      if (!read_back) queue.enqueueReadBuffer(it->second.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
+      read_back = true;
+    } else {  // make the host view of the USE_HOST_PTR output valid (no copy on CPU devices)
       queue.enqueueUnmapMemObject(it->second.color_out,
                                   queue.enqueueMapBuffer(it->second.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes()));
-    return double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
-  });
+    }
+    const double seconds =
+        double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
+    pass_s += seconds;
+    return seconds;
+  }, rt->is_cpu());
+  if (pass_s > 0 && copy_s > 0) {
+    state.counters["copy_ms"] = copy_s / double(state.iterations()) * 1e3;
+    state.counters["bw_vs_copy"] = (double(pass_bytes(frame_in)) / pass_s) / (double(copy.bytes_moved()) / copy_s);
+  }
+}
+
+void BM_DeviceCopy(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  const DemoFrame& f = frame(int(state.range(0)), int(state.range(1)), state.range(2) ? ColorFormat::rgba16f : ColorFormat::rgba32f);
+  const DeviceCopy& copy = device_copy(wrap(rt->context()), f);
+  const cl::CommandQueue queue = wrap(rt->queue());
+  copy.seconds(queue);  // first touch of the buffers
+  for (auto _ : state) state.SetIterationTime(copy.seconds(queue));
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(copy.bytes_moved()));
 }
 
 void BM_OpenCLHostCall(benchmark::State& state) {
@@ -412,6 +481,13 @@ BENCHMARK(BM_OpenMPSimdFastMath)->Apply(FogArgs);
 BENCHMARK(BM_OpenCLDevice)->Apply(DeviceArgs);
 BENCHMARK(BM_OpenCLDevice)->Name("BM_OpenCLDeviceCacheResident")->Apply(CacheResidentArgs);
 BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
+BENCHMARK(BM_DeviceCopy)
+    ->ArgNames({"w", "h", "f16"})
+    ->ArgsProduct({{1920}, {1080}, {0, 1}})
+    ->ArgsProduct({{3840}, {2160}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2);
 BENCHMARK(BM_OpticalDepth)->ArgName("log10_density_d")->Arg(0)->Arg(2)->Arg(3)->Arg(20)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ProgramBuild)->ArgName("cold")->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_FirstDispatch)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);

@@ -5,6 +5,8 @@
 //        composite = the composite kernel), counters march_ms, composite_ms and
 //        steps_x_pixels_per_s = steps x target pixels / march time; max_err against the scalar
 //        double path at 480x270
+//   BM_VolumeHostCall/integrator/divisor/noise_image/width   the convenience call, host images in
+//        and out (enqueue to finish): on a GPU the host round trip, upload + pass + download
 //   BM_VolumeScalar/integrator/width   the scalar float path, one thread
 //   BM_VolumeNothingVisible   enqueue of a frame whose volumes are all culled: no kernel, the
 //        host-side cost of the call
@@ -127,6 +129,18 @@ void BM_VolumeDevice(benchmark::State& state) {
   }
 }
 
+void BM_VolumeHostCall(benchmark::State& state) {
+  const auto integrator = VolumeIntegrator(state.range(0));
+  const int divisor = int(state.range(1)), width = int(state.range(3));
+  const DemoFrame& f = frame(width);
+  const VolumeScene s = scene(integrator);
+  const VolumeSettings st = settings(integrator, divisor, state.range(2) != 0);
+  VolumePass pass(runtime());
+  ColorImage out;
+  pass.apply(f.color, f.depth, out, f.params, s, st);  // builds the variant, uploads the noise
+  for (auto _ : state) pass.apply(f.color, f.depth, out, f.params, s, st);
+}
+
 void BM_VolumeScalar(benchmark::State& state) {
   const auto integrator = VolumeIntegrator(state.range(0));
   const int width = int(state.range(1));
@@ -167,6 +181,11 @@ BENCHMARK(BM_VolumeDevice)
     ->ArgsProduct({{0, 1}, {1, 2, 4}, {0, 1}, {480}})
     ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}, {1920}})
     ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
+BENCHMARK(BM_VolumeHostCall)
+    ->ArgNames({"integrator", "divisor", "noise_image", "width"})
+    ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}, {1920}})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeScalar)

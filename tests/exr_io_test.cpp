@@ -31,6 +31,7 @@
 #include "fogcl/error.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/image.h"
+#include "test_support.h"
 
 namespace {
 
@@ -122,7 +123,7 @@ class ExrIoTest : public ::testing::Test {
   void SetUp() override {
     // One folder per test: ctest may run tests in parallel and each checks its folder for leftovers.
     const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    dir_ = fs::path(FOGCL_TEST_TMP) / ("exrio_" + test);
+    dir_ = fs::path(fogcl::test::temp_dir()) / ("exrio_" + test);
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

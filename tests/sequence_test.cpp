@@ -374,7 +374,7 @@ TEST_F(Sequence, BadOutputChoicesNameTheValueAndWriteNothing) {
 
 // The CLI started in the background, its output in `log`.
 pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries) {
-  std::vector<std::string> words{FOGCL_CLI_PATH};
+  std::vector<std::string> words{cli_path()};
   for (std::size_t at = 0; at < args.size();) {
     const std::size_t end = std::min(args.find(' ', at), args.size());
     if (end > at) words.push_back(args.substr(at, end - at));

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 #include <filesystem>
 #include <memory>
@@ -130,7 +131,8 @@ ColorImage white_like(const ColorImage& like) {
 
 std::string temp_dir() {
   static const std::string dir = [] {
-    std::filesystem::path p = FOGCL_TEST_TMP;
+    const char* env = std::getenv("FOGCL_TEST_DIR");
+    std::filesystem::path p = env != nullptr && *env != '\0' ? env : FOGCL_TEST_TMP;
     std::filesystem::create_directories(p);
     return p.string();
   }();
@@ -144,8 +146,16 @@ std::string num(float v) {
   return s.str();
 }
 
+const std::string& cli_path() {
+  static const std::string path = [] {
+    const char* env = std::getenv("FOGCL_TEST_CLI");
+    return std::string(env != nullptr && *env != '\0' ? env : FOGCL_CLI_PATH);
+  }();
+  return path;
+}
+
 CliRun run_cli(const std::string& args, const std::string& env) {
-  const std::string cmd = env + " " + std::string(FOGCL_CLI_PATH) + " " + args + " 2>&1";
+  const std::string cmd = env + " " + cli_path() + " " + args + " 2>&1";
   CliRun r{-1, {}};
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return r;

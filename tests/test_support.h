@@ -67,7 +67,10 @@ ColorImage white_like(const ColorImage& like);
 // Size of one half-precision ulp at |x|.
 double half_ulp(double x);
 
-std::string temp_dir();  // a per-run scratch folder
+std::string temp_dir();  // a per-run scratch folder: FOGCL_TEST_DIR, else the build tree's tests/tmp
+// The fogcl CLI under test: FOGCL_TEST_CLI, else the one this build made. Both variables exist
+// for runs outside the build tree (scripts/gpu-run.sh on the GPU machine).
+const std::string& cli_path();
 
 // Runs fn, expects fogcl::Error, returns its message ("" and a test failure otherwise).
 template <class Fn>

@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Builds what the GPU machine needs and puts it in one folder to carry there.
+#   scripts/gpu-bundle.sh [BUILD_DIR] [BUNDLE_DIR]      (defaults: build, out/gpu-bundle)
+# The bundle: bin/ (the CLI, the test suite, both benchmarks), lib/ (every shared library they
+# load, glibc's own excepted: gpu-run.sh links only those the GPU machine lacks), gpu-run.sh and
+# gpu_summary.py. Then, on the GPU machine, from the bundle: ./gpu-run.sh RESULTS_DIR
+# (README, "On a GPU").
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+root=$(dirname "$here")
+build=${1:-build}
+bundle=${2:-out/gpu-bundle}
+cd "$root"
+
+"$here/setup.sh" --bench
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build" -j "$(nproc)" --target fogcl_cli fogcl_tests fogcl_bench fogcl_volume_bench
+
+rm -rf "$bundle"
+mkdir -p "$bundle/bin" "$bundle/lib"
+bins=("$build/src/fogcl" "$build/tests/fogcl_tests" "$build/bench/fogcl_bench" "$build/bench/fogcl_volume_bench")
+cp "${bins[@]}" "$bundle/bin/"
+strip --strip-debug "$bundle"/bin/*
+
+# glibc and the dynamic loader must be the target's own; everything else travels and gpu-run.sh
+# decides per library.
+ldd "${bins[@]}" | awk '/=> \// {print $3}' | sort -u | while read -r lib; do
+  case "$(basename "$lib")" in
+    libc.so.*|libm.so.*|libdl.so.*|libpthread.so.*|librt.so.*|ld-linux*|libgcc_s.so.*) ;;
+    *) cp -L "$lib" "$bundle/lib/" ;;
+  esac
+done
+cp "$here/gpu-run.sh" "$here/gpu_summary.py" "$bundle/"
+git rev-parse --short HEAD >"$bundle/COMMIT" 2>/dev/null || echo unknown >"$bundle/COMMIT"
+echo "bundle: $bundle ($(du -sh "$bundle" | cut -f1), commit $(cat "$bundle/COMMIT"))"
+ls "$bundle/bin" "$bundle/lib"

@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# On the GPU machine, from the bundle scripts/gpu-bundle.sh made:
+#   ./gpu-run.sh RESULTS_DIR [tests|bench|pocl|all]...      (default: all)
+# Registers NVIDIA's OpenCL driver with the ICD loader (OCL_ICD_VENDORS: a private vendors folder
+# with nvidia.icd next to the machine's own .icd files, e.g. its PoCL), links from the bundle
+# only the libraries the machine lacks, then
+#   tests  the whole test suite with FOGCL_DEVICE=gpu, in parallel shards (gtest XML per shard)
+#   bench  both benchmarks on the GPU (device-resident and host round trip, the device copy)
+#   pocl   the volumetric march on the machine's PoCL, 1 to all cores (POCL_MAX_PTHREAD_COUNT)
+# and writes RESULTS_DIR/summary.md from what they left (gpu_summary.py).
+set -uo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+results=${1:?usage: gpu-run.sh RESULTS_DIR [tests|bench|pocl|all]...}
+shift
+parts=("${@:-all}")
+mkdir -p "$results"
+results=$(cd "$results" && pwd)
+scratch=$(mktemp -d)
+want() { local p; for p in "${parts[@]}"; do [ "$p" = all ] || [ "$p" = "$1" ] && return 0; done; return 1; }
+
+# --- OpenCL: NVIDIA's driver next to the machine's registered ICDs ------------------------------
+mkdir -p "$scratch/icd"
+cp /etc/OpenCL/vendors/*.icd "$scratch/icd/" 2>/dev/null
+nvidia=$( (ldconfig -p | awk '/libnvidia-opencl.so.1 / {print $NF}'; ls /usr/local/nvidia/lib64/libnvidia-opencl.so.1 \
+           /usr/lib/x86_64-linux-gnu/libnvidia-opencl.so.1 /usr/lib/libnvidia-opencl.so.1 2>/dev/null) | head -1)
+if [ -z "$nvidia" ]; then
+  echo "gpu-run: libnvidia-opencl.so.1 not found (is this the GPU machine?)" >&2
+  exit 2
+fi
+echo "$nvidia" >"$scratch/icd/nvidia.icd"
+export OCL_ICD_VENDORS="$scratch/icd"
+
+# --- Libraries: the machine's own where it has them (a newer libstdc++ serves our binaries and
+# its PoCL alike), the bundle's for the rest ---------------------------------------------------
+mkdir -p "$scratch/lib"
+for lib in "$here"/lib/*; do
+  name=$(basename "$lib")
+  ldconfig -p | grep -q "^[[:space:]]$name " || ln -s "$lib" "$scratch/lib/$name"
+done
+export LD_LIBRARY_PATH="$scratch/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+
+{
+  echo "commit: $(cat "$here/COMMIT" 2>/dev/null)"
+  echo "date: $(date -u +%FT%TZ)"
+  echo "host: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')"
+  nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader 2>/dev/null | sed 's/^/gpu: /'
+  echo "OCL_ICD_VENDORS: $(ls "$scratch/icd" | tr '\n' ' ')"
+  echo "bundled libraries used: $(ls "$scratch/lib" | tr '\n' ' ')"
+} | tee "$results/machine.txt"
+
+bin="$here/bin"
+status=0
+
+# --- The whole suite on the GPU ------------------------------------------------------------------
+if want tests; then
+  shards=${GPU_TEST_SHARDS:-8}
+  mkdir -p "$scratch/tests"
+  echo "tests: fogcl_tests with FOGCL_DEVICE=gpu in $shards shards"
+  start=$(date +%s)
+  for i in $(seq 0 $((shards - 1))); do
+    FOGCL_DEVICE=gpu FOGCL_TEST_CLI="$bin/fogcl" FOGCL_TEST_DIR="$scratch/tests" GTEST_TOTAL_SHARDS=$shards \
+      GTEST_SHARD_INDEX=$i timeout "${GPU_TEST_TIMEOUT:-540}" "$bin/fogcl_tests" \
+      --gtest_output="xml:$results/tests-$i.xml" >"$results/tests-$i.log" 2>&1 &
+  done
+  wait
+  echo "tests: $(( $(date +%s) - start )) s"
+fi
+
+# --- Benchmarks on the GPU -----------------------------------------------------------------------
+bench() {  # bench BINARY JSON FILTER [args...]
+  "$bin/$1" --benchmark_out_format=json --benchmark_out="$results/$2" --benchmark_filter="$3" "${@:4}" \
+    >"$results/${2%.json}.txt" 2>&1 || { echo "bench: $1 $3 failed (see ${2%.json}.txt)"; status=1; }
+}
+if want bench; then
+  echo "bench: deferred pass on the GPU"
+  FOGCL_DEVICE=gpu bench fogcl_bench fog-gpu.json \
+    'BM_DeviceCopy|BM_OpenCLDevice/w:(1920|3840)/h:(1080|2160)/.*/nt:0|BM_OpenCLHostCall/w:(1920|3840)|BM_DispatchOverhead|BM_FirstDispatch|BM_ProgramBuild' \
+    --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+  echo "bench: volumetric pass on the GPU"
+  FOGCL_DEVICE=gpu bench fogcl_volume_bench volume-gpu.json 'BM_VolumeDevice|BM_VolumeHostCall|BM_VolumeNothingVisible' \
+    --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+  bench fogcl_volume_bench volume-scalar.json 'BM_VolumeScalar'
+fi
+
+# --- PoCL on every core: the volumetric march from 1 thread to all -----------------------------
+if want pocl; then
+  cores=$(nproc)
+  for t in 1 2 4 8 16 32 64; do
+    [ "$t" -le "$cores" ] || break
+    echo "pocl: $t threads"
+    FOGCL_DEVICE=cpu POCL_MAX_PTHREAD_COUNT=$t bench fogcl_volume_bench "volume-pocl-$t.json" \
+      'BM_VolumeDevice/integrator:[01]/divisor:2/noise_image:0/width:1920' --benchmark_repetitions=3 \
+      --benchmark_report_aggregates_only=true
+  done
+fi
+
+python3 "$here/gpu_summary.py" "$results" >"$results/summary.md" || status=1
+cat "$results/summary.md"
+rm -rf "$scratch"
+grep -q "^FAILED" "$results/summary.md" && status=1
+exit $status

@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""Summarises a gpu-run.sh results folder as Markdown on stdout: the test suite's totals,
+failures and skips, then the benchmarks against issue #16's targets. A line starting with
+"FAILED" marks a failed test or a missed target (gpu-run.sh exits non-zero on one)."""
+import glob
+import json
+import os
+import re
+import sys
+import xml.etree.ElementTree as ET
+
+results = sys.argv[1] if len(sys.argv) > 1 else "."
+out = []
+
+
+def p(line=""):
+    out.append(line)
+
+
+def load(name):
+    path = os.path.join(results, name)
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        text = f.read()
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError:
+        return []
+    rows = []
+    for b in data.get("benchmarks", []):
+        if b.get("run_type") == "aggregate" and b.get("aggregate_name") != "median":
+            continue
+        b = dict(b)
+        b["base"] = b.get("run_name", b["name"])
+        rows.append(b)
+    return rows
+
+
+def ms(b):
+    scale = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}[b.get("time_unit", "ns")]
+    return b["real_time"] * scale
+
+
+def args(name):
+    return dict(re.findall(r"(\w+):(\d+)", name))
+
+
+with open(os.path.join(results, "machine.txt")) if os.path.exists(os.path.join(results, "machine.txt")) else open(os.devnull) as f:
+    p("# fogcl on the GPU machine")
+    p()
+    for line in f:
+        p("- " + line.rstrip())
+    p()
+
+# ---- tests -----------------------------------------------------------------------------------
+xmls = sorted(glob.glob(os.path.join(results, "tests-*.xml")))
+logs = sorted(glob.glob(os.path.join(results, "tests-*.log")))
+if logs:
+    passed, failed, skipped = 0, [], []
+    for x in xmls:
+        for case in ET.parse(x).getroot().iter("testcase"):
+            name = f'{case.get("classname")}.{case.get("name")}'
+            failure = case.find("failure")
+            skip = case.find("skipped")
+            if failure is not None:
+                failed.append((name, (failure.get("message") or "").splitlines()[0:3]))
+            elif skip is not None or case.get("result") == "skipped":
+                msg = (skip.get("message") if skip is not None else "") or ""
+                skipped.append((name, msg.strip().splitlines()[-1] if msg.strip() else ""))
+            else:
+                passed += 1
+    p("## Test suite (FOGCL_DEVICE=gpu)")
+    p()
+    p(f"{passed} passed, {len(failed)} failed, {len(skipped)} skipped ({len(xmls)} of {len(logs)} shards wrote XML)")
+    p()
+    if len(xmls) < len(logs):
+        p(f"FAILED: {len(logs) - len(xmls)} shards ended without their XML (crash or timeout: see tests-N.log)")
+    for name, msg in failed:
+        p(f"FAILED: {name}: {' / '.join(m.strip() for m in msg)}")
+    if skipped:
+        p()
+        p("Skipped, with the reason:")
+        for name, msg in skipped:
+            p(f"- {name}: {msg}")
+    p()
+
+# ---- deferred pass ---------------------------------------------------------------------------
+fog = load("fog-gpu.json")
+if fog:
+    copies = {}
+    for b in fog:
+        if b["base"].startswith("BM_DeviceCopy/"):
+            a = args(b["base"])
+            copies[(a["w"], a["f16"])] = b
+    host = {}
+    for b in fog:
+        if b["base"].startswith("BM_OpenCLHostCall/"):
+            a = args(b["base"])
+            host[(a["w"], a["mode"], a["dist"], a["f16"])] = b
+    p("## Deferred pass on the GPU (median of 3)")
+    p()
+    p("Device-resident: device buffers, kernel time from profiling events. Copy: clEnqueueCopyBuffer of")
+    p("color and depth (read + written bytes). bw_vs_copy = pass bandwidth / copy bandwidth, the copy")
+    p("interleaved with the pass's iterations. Round trip: the convenience call (upload + kernel + download).")
+    p()
+    p("| frame | mode | metric | color | device ms | GB/s | copy GB/s | bw_vs_copy | round trip ms | max err |")
+    p("|---|---|---|---|---:|---:|---:|---:|---:|---:|")
+    modes = {"0": "linear", "1": "exp", "2": "exp2"}
+    worst = {}
+    for b in fog:
+        if not b["base"].startswith("BM_OpenCLDevice/"):
+            continue
+        a = args(b["base"])
+        copy = copies.get((a["w"], a["f16"]))
+        rt = host.get((a["w"], a["mode"], a["dist"], a["f16"]))
+        fmt = "f16" if a["f16"] == "1" else "f32"
+        ratio = b.get("bw_vs_copy", float("nan"))
+        if a["w"] == "3840":
+            worst[fmt] = min(worst.get(fmt, 9e9), ratio)
+        p(f'| {a["w"]}x{a["h"]} | {modes[a["mode"]]} | {"distance" if a["dist"] == "1" else "depth"} | {fmt} '
+          f'| {ms(b):.4f} | {b["bytes_per_second"] / 1e9:.0f} '
+          f'| {copy["bytes_per_second"] / 1e9 if copy else float("nan"):.0f} | {ratio:.2f} '
+          f'| {ms(rt) if rt else float("nan"):.2f} | {b.get("max_err", float("nan")):.2g} |')
+    p()
+    for fmt, r in sorted(worst.items()):
+        verdict = "met" if r >= 0.8 else "FAILED"
+        line = f"4K device-resident {fmt}: worst bw_vs_copy {r:.2f} (target >= 0.8): {verdict}"
+        p(line if verdict == "met" else "FAILED: " + line)
+    for b in fog:
+        if re.match(r"BM_(DispatchOverhead|FirstDispatch|ProgramBuild)", b["base"]):
+            p(f'- {b["base"].split("/min_time")[0].split("/manual_time")[0]}: {ms(b):.3f} ms')
+    p()
+
+# ---- volumetric pass -------------------------------------------------------------------------
+vol = load("volume-gpu.json")
+if vol:
+    integ = {"0": "stylized", "1": "physical"}
+    p("## Volumetric pass on the GPU (demo scene, 4 volumes, 64 steps, noise on; median of 3)")
+    p()
+    p("| frame | integrator | resolution | noise | march ms | composite ms | device ms | steps·px/s | round trip ms | max err (480x270) |")
+    p("|---|---|---|---|---:|---:|---:|---:|---:|---:|")
+    errs = {}
+    host = {}
+    for b in vol:
+        a = args(b["base"])
+        if b["base"].startswith("BM_VolumeDevice/") and a["width"] == "480":
+            errs[(a["integrator"], a["divisor"], a["noise_image"])] = b.get("max_err", float("nan"))
+        if b["base"].startswith("BM_VolumeHostCall/"):
+            host[(a["integrator"], a["divisor"], a["noise_image"], a["width"])] = b
+    for b in vol:
+        if not b["base"].startswith("BM_VolumeDevice/"):
+            continue
+        a = args(b["base"])
+        res = {"1": "full", "2": "half", "4": "quarter"}[a["divisor"]]
+        key = (a["integrator"], a["divisor"], a["noise_image"])
+        rt = host.get(key + (a["width"],))
+        p(f'| {a["width"]}x{int(a["width"]) * 9 // 16} | {integ[a["integrator"]]} | {res} '
+          f'| {"image" if a["noise_image"] == "1" else "buffer"} | {b["march_ms"]:.3f} | {b["composite_ms"]:.3f} '
+          f'| {ms(b):.3f} | {b["steps_x_pixels_per_s"]:.3g} | {ms(rt) if rt else float("nan"):.2f} '
+          f'| {errs.get(key, float("nan")):.2g} |')
+    p()
+    for b in vol:
+        a = args(b["base"])
+        if b["base"].startswith("BM_VolumeDevice/") and a["width"] == "1920":
+            limit = 4.0 if a["divisor"] == "1" else 1.0
+            res = "full" if a["divisor"] == "1" else "half"
+            noise = "image" if a["noise_image"] == "1" else "buffer"
+            ok = ms(b) <= limit
+            line = f'1080p {integ[a["integrator"]]} {res}, noise {noise}: {ms(b):.3f} ms (target <= {limit:g} ms): {"met" if ok else "missed"}'
+            p("- " + line)
+        if b["base"].startswith("BM_VolumeNothingVisible"):
+            p(f'- nothing visible: {ms(b) * 1e3:.1f} µs, {b.get("dispatches", 0):.0f} dispatches')
+    p()
+scalar = load("volume-scalar.json")
+for b in scalar:
+    a = args(b["base"])
+    p(f'- scalar float march, 480x270 half, {"stylized" if a["integrator"] == "0" else "physical"}, one thread: '
+      f'{ms(b):.1f} ms, {b["steps_x_pixels_per_s"]:.3g} steps·px/s')
+if scalar:
+    p()
+
+# ---- PoCL scaling ----------------------------------------------------------------------------
+pocl = sorted(glob.glob(os.path.join(results, "volume-pocl-*.json")), key=lambda s: int(re.findall(r"(\d+)\.json", s)[0]))
+if pocl:
+    p("## PoCL on the machine's cores: the volumetric march, 1080p half, noise buffer (median of 3)")
+    p()
+    p("| threads | stylized march ms | speed-up | physical march ms | speed-up |")
+    p("|---:|---:|---:|---:|---:|")
+    base = {}
+    for path in pocl:
+        t = re.findall(r"(\d+)\.json", path)[0]
+        cells = {}
+        for b in load(os.path.basename(path)):
+            if "march_ms" in b:
+                cells[args(b["base"])["integrator"]] = b["march_ms"]
+        for i in cells:
+            base.setdefault(i, cells[i])
+        row = [t]
+        for i in ("0", "1"):
+            if i in cells:
+                row += [f"{cells[i]:.1f}", f"{base[i] / cells[i]:.1f}x"]
+            else:
+                row += ["", ""]
+        p("| " + " | ".join(row) + " |")
+    p()
+
+print("\n".join(out))
