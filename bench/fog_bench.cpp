@@ -266,7 +266,7 @@ void BM_OpenCLDevice(benchmark::State& state) {
   const DemoFrame& frame_in = frame(c.w, c.h, c.format);
   const DeviceCopy& copy = device_copy(wrap(rt->context()), frame_in);
   double pass_s = 0, copy_s = 0;
-  bool read_back = false;
+  bool read_back = false, first = true;
   timed_fog(state, state.range(5) ? "opencl-device-nt" : "opencl-device", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     // Buffers wrap the same host memory every time (created once per frame and output).
     // The cl::Buffers own the handles; FrameBuffers borrows them.
@@ -292,8 +292,11 @@ void BM_OpenCLDevice(benchmark::State& state) {
       b.fb.depth = b.depth();
       b.fb.color_out = b.color_out();
       it = buffers.emplace(key, b).first;
-      pass.prepare(s, f.params, f.color.format());  // builds the variant
-      adopt(pass.enqueue(rt->queue(), b.fb, f.params, s)).wait();  // first dispatch
+    }
+    if (first) {  // build the variant (a cache hit after the first run) and dispatch it once
+      pass.prepare(s, f.params, f.color.format());
+      adopt(pass.enqueue(rt->queue(), it->second.fb, f.params, s)).wait();
+      first = false;
     }
     const cl::Event e = adopt(pass.enqueue(rt->queue(), it->second.fb, f.params, s));
     e.wait();

@@ -24,7 +24,7 @@ class Cli : public ::testing::Test {
     dir_ = temp_dir() + "/cli-" + std::to_string(::getpid());
     fs::remove_all(dir_);
     const CliRun demo = run_cli("demo --out " + dir_ + " --width 96 --height 54 --device " +
-                             std::string(runtime() ? "cpu" : "scalar"));
+                             cli_device());
     demo_output_ = demo.output;
     demo_ok_ = demo.exit_code == 0;
   }
@@ -58,7 +58,7 @@ TEST_F(Cli, DemoVolumeRowsAreReproducedByApply) {
   std::string line = demo_output_.substr(at + 8, demo_output_.find('\n', at) - at - 8);
   const std::string kind = runtime() ? "opencl" : "scalar";
   line.replace(line.find("OUT.exr"), 7, in("apply-volumes.exr"));
-  const CliRun r = run_cli(line + " --device " + (runtime() ? "cpu" : "scalar"));
+  const CliRun r = run_cli(line + " --device " + cli_device());
   ASSERT_EQ(r.exit_code, 0) << line << "\n" << r.output;
   const ColorImage got = read_exr_color(in("apply-volumes.exr"));
   const ColorImage want = read_exr_color(in("volumes-stylized-shadow-" + kind + ".exr"));

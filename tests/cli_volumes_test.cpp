@@ -183,7 +183,7 @@ TEST_F(CliVolumes, ScalarPathEqualsTheLibraryBitForBit) {
 TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
   FOGCL_REQUIRE_DEVICE();
   std::string output;
-  const ColorImage got = run_ok(base_args() + " --device cpu --verbose", "opencl.exr", &output);
+  const ColorImage got = run_ok(base_args() + " --device " + cli_device() + " --verbose", "opencl.exr", &output);
   ASSERT_GT(got.width(), 0);
   const VolumeScene s = scene();
   VolumePass pass(*runtime());
@@ -192,7 +192,7 @@ TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
   const VolumeResult<double> ref =
       volumes_scalar<double>(frame_->color, frame_->depth, frame_->params, s, VolumeSettings{});
   const std::size_t diff = differing_floats(got, want);
-  std::printf("[ measured ] CLI --device cpu vs VolumePass::apply: %zu differing floats; vs double: max %.3g\n", diff,
+  std::printf("[ measured ] CLI --device (the tests' device) vs VolumePass::apply: %zu differing floats; vs double: max %.3g\n", diff,
               max_abs_rgb_error(got, ref));
   EXPECT_EQ(diff, 0u);
   EXPECT_LE(max_abs_rgb_error(got, ref), 1e-4);
@@ -204,7 +204,7 @@ TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
   EXPECT_MSG_HAS(output, pass.last_march_options());
 
   // --noise-sampling image: the noise as an OpenCL 3D image with the sampler's filtering.
-  const ColorImage image = run_ok(base_args() + " --device cpu --noise-sampling image --verbose", "image.exr", &output);
+  const ColorImage image = run_ok(base_args() + " --device " + cli_device() + " --noise-sampling image --verbose", "image.exr", &output);
   VolumeSettings st;
   st.noise_sampling = NoiseSampling::image;
   pass.apply(frame_->color, frame_->depth, want, frame_->params, s, st);
@@ -221,7 +221,7 @@ TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
 // those settings change the picture (so an ignored flag would fail the first check).
 TEST_F(CliVolumes, EveryFlagReachesThePass) {
   const bool cl = runtime() != nullptr;
-  const std::string args = base_args() + " --device " + (cl ? "cpu" : "scalar") +
+  const std::string args = base_args() + " --device " + (cl ? cli_device() : std::string("scalar")) +
                            " --integrator physical --steps 12 --volume-resolution quarter --upsample bilinear"
                            " --noise-size 32 --noise-seed 7 --time 1.5 --frame 3 --shadow-map " +
                            in("shadow.exr") + " --light-view-proj " + matrix_;

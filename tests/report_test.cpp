@@ -198,13 +198,13 @@ class CliIssue5 : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = fresh_dir("cli5");
     const CliRun demo = run_cli("demo --out " + dir_ + " --width 48 --height 27 --device " +
-                                std::string(runtime() ? "cpu" : "scalar"));
+                                cli_device());
     demo_ok_ = demo.exit_code == 0;
     demo_output_ = demo.output;
   }
   void SetUp() override { ASSERT_TRUE(demo_ok_) << demo_output_; }
   static std::string in(const std::string& name) { return dir_ + "/" + name; }
-  static std::string device() { return runtime() ? "cpu" : "scalar"; }
+  static std::string device() { return cli_device(); }
 
   // Runs apply, then compares its output with fog_scalar<double> for `params`.
   static void check_apply(const std::string& args, const std::string& color_file, const std::string& depth_file,
@@ -299,7 +299,7 @@ TEST_F(CliIssue5, MaxErrorPicksTheVariantFromTheCache) {
   PerspectiveCamera cam;
   cam.aspect = 48.0f / 27.0f;
   const std::string common = "apply --color " + in("scene.exr") + " --depth " + in("scene-depth.exr") +
-                             " --near 0.3 --far 1000 --fov 60 --device cpu --verbose" + kExpFog;
+                             " --near 0.3 --far 1000 --fov 60 --device " + cli_device() + " --verbose" + kExpFog;
   const std::string out = in("budget.exr");
   const CliRun r = run_cli(common + " --max-error 1 --out " + out, env);
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -154,6 +154,8 @@ const std::string& cli_path() {
   return path;
 }
 
+std::string cli_device() { return runtime() != nullptr ? resolve_device_choice() : std::string("scalar"); }
+
 CliRun run_cli(const std::string& args, const std::string& env) {
   const std::string cmd = env + " " + cli_path() + " " + args + " 2>&1";
   CliRun r{-1, {}};

@@ -71,6 +71,9 @@ std::string temp_dir();  // a per-run scratch folder: FOGCL_TEST_DIR, else the b
 // The fogcl CLI under test: FOGCL_TEST_CLI, else the one this build made. Both variables exist
 // for runs outside the build tree (scripts/gpu-run.sh on the GPU machine).
 const std::string& cli_path();
+// The CLI's --device value for the device the tests run on: FOGCL_DEVICE's choice (cpu unless
+// set), or scalar where no OpenCL device exists. CLI-vs-library tests compare like with like.
+std::string cli_device();
 
 // Runs fn, expects fogcl::Error, returns its message ("" and a test failure otherwise).
 template <class Fn>

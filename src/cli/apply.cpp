@@ -323,11 +323,11 @@ int run_apply(const ApplyOptions& o) {
       if (p->is_sequence)
         throw Error("'" + p->text + "' has a frame placeholder but --color '" + o.color_path + "' has none");
     if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
-    Backend backend(o.device);
-    const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
     FrameJob job;
     job.paths = {o.color_path, o.depth_path, o.out_path, o.png_path};
-    read_frame(o, job);
+    read_frame(o, job);  // a bad input is named before (and whether or not) a device opens
+    Backend backend(o.device);
+    const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
     fog_frame(o, backend, job, o.verbose, volumes.get(), -1);
     write_frame(o, job);
     return 0;
