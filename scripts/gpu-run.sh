@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # On the GPU machine, from the bundle scripts/gpu-bundle.sh made:
 #   ./gpu-run.sh RESULTS_DIR [tests|bench|pocl|all]...      (default: all)
+#   ./gpu-run.sh RESULTS_DIR exec COMMAND [ARGS...]          (COMMAND under the same setup)
 # Registers NVIDIA's OpenCL driver with the ICD loader (OCL_ICD_VENDORS: a private vendors folder
 # with nvidia.icd next to the machine's own .icd files, e.g. its PoCL), links from the bundle
 # only the libraries the machine lacks, then
@@ -50,6 +51,12 @@ export LD_LIBRARY_PATH="$scratch/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 
 bin="$here/bin"
 status=0
+if [ "${parts[0]}" = exec ]; then
+  "${parts[@]:1}"
+  status=$?
+  rm -rf "$scratch"
+  exit $status
+fi
 
 # --- The whole suite on the GPU ------------------------------------------------------------------
 if want tests; then

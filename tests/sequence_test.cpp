@@ -386,6 +386,7 @@ pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temp
     ::dup2(fd, 1);
     ::dup2(fd, 2);
     if (named_temporaries) ::setenv("FOGCL_TEMP_FILES", "named", 1);
+    restore_start_opencl_env();
     std::vector<char*> argv;
     for (std::string& w : words) argv.push_back(w.data());
     argv.push_back(nullptr);

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <random>
 
 #include <Imath/half.h>
@@ -154,10 +155,28 @@ const std::string& cli_path() {
   return path;
 }
 
+namespace {
+// Read during static initialisation, before any OpenCL call of the test process.
+const std::optional<std::string> kIcdFilenamesAtStart = []() -> std::optional<std::string> {
+  const char* v = std::getenv("OCL_ICD_FILENAMES");
+  return v != nullptr ? std::optional<std::string>(v) : std::nullopt;
+}();
+}  // namespace
+
+void restore_start_opencl_env() {
+  if (kIcdFilenamesAtStart)
+    setenv("OCL_ICD_FILENAMES", kIcdFilenamesAtStart->c_str(), 1);
+  else
+    unsetenv("OCL_ICD_FILENAMES");
+}
+
 std::string cli_device() { return runtime() != nullptr ? resolve_device_choice() : std::string("scalar"); }
 
 CliRun run_cli(const std::string& args, const std::string& env) {
-  const std::string cmd = env + " " + cli_path() + " " + args + " 2>&1";
+  // The child gets the OpenCL loader environment the tests started with (restore_start_opencl_env).
+  const std::string loader_env =
+      kIcdFilenamesAtStart ? "OCL_ICD_FILENAMES='" + *kIcdFilenamesAtStart + "'" : "env -u OCL_ICD_FILENAMES";
+  const std::string cmd = loader_env + " " + env + " " + cli_path() + " " + args + " 2>&1";
   CliRun r{-1, {}};
   FILE* p = popen(cmd.c_str(), "r");
   if (p == nullptr) return r;

@@ -74,6 +74,10 @@ const std::string& cli_path();
 // The CLI's --device value for the device the tests run on: FOGCL_DEVICE's choice (cpu unless
 // set), or scalar where no OpenCL device exists. CLI-vs-library tests compare like with like.
 std::string cli_device();
+// Gives the calling (child) process the OpenCL loader environment the test process started with.
+// PoCL 5.0 sets OCL_ICD_FILENAMES=libpocl.so.2 in the process that loads it (seen on Ubuntu 24.04
+// with NVIDIA's driver registered beside it): a CLI started after that would see PoCL alone.
+void restore_start_opencl_env();
 
 // Runs fn, expects fogcl::Error, returns its message ("" and a test failure otherwise).
 template <class Fn>

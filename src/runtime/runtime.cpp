@@ -21,7 +21,10 @@ struct Candidate {
   std::string label;  // "device name (platform name)"
 };
 
-std::vector<Candidate> all_devices() {
+// Platforms that failed to list their devices, with the CL error ("" if none): a driver that is
+// registered but does not come up (e.g. a GPU driver in a container without the device) is named
+// in find_device's message instead of vanishing from the list.
+std::vector<Candidate> all_devices(std::string* failed_platforms = nullptr) {
   std::vector<cl::Platform> platforms;
   try {
     cl::Platform::get(&platforms);
@@ -35,8 +38,12 @@ std::vector<Candidate> all_devices() {
     std::vector<cl::Device> devices;
     try {
       p.getDevices(CL_DEVICE_TYPE_ALL, &devices);
-    } catch (const cl::Error&) {
-      continue;  // a platform without devices (CL_DEVICE_NOT_FOUND) is not an error here
+    } catch (const cl::Error& e) {
+      // A platform without devices (CL_DEVICE_NOT_FOUND) is not an error here; others are noted.
+      if (e.err() != CL_DEVICE_NOT_FOUND && failed_platforms != nullptr)
+        *failed_platforms += "; " + p.getInfo<CL_PLATFORM_NAME>() + " platform failed to list its devices: " +
+                             cl_error_name(e.err());
+      continue;
     }
     for (const auto& d : devices)
       out.push_back({p, d, d.getInfo<CL_DEVICE_NAME>() + " (" + p.getInfo<CL_PLATFORM_NAME>() + ")"});
@@ -65,7 +72,8 @@ std::string device_name(cl_device_id device) {
 
 cl_device_id find_device(const std::string& choice) {
   return with_cl_errors([&] {
-    const std::vector<Candidate> all = all_devices();
+    std::string failed;
+    const std::vector<Candidate> all = all_devices(&failed);
     const std::string want = lower(choice);
     const Candidate* found = nullptr;
     for (const auto& c : all) {
@@ -87,7 +95,7 @@ cl_device_id find_device(const std::string& choice) {
       std::string list;
       for (const auto& c : all) list += (list.empty() ? "" : "; ") + c.label;
       throw Error("no OpenCL device matches '" + choice + "' (use cpu, gpu, scalar or part of a device name; available: " +
-                  (list.empty() ? std::string("none") : list) + ")");
+                  (list.empty() ? std::string("none") : list) + failed + ")");
     }
     return found->device();  // root devices are not reference counted: the handle outlives `all`
   });
