@@ -2,7 +2,7 @@
 BUILD ?= build
 JOBS ?= $(shell nproc)
 
-.PHONY: setup build demo test bench clean asan-build asan-test fuzz
+.PHONY: setup build demo test bench clean asan-build asan-test fuzz gpu-bundle
 
 setup:
 	scripts/setup.sh
@@ -22,6 +22,10 @@ test: build
 bench: build
 	scripts/setup.sh --bench
 	bench/run.sh $(BUILD) out/bench
+
+# What the GPU machine needs, in out/gpu-bundle: carry it there and run its gpu-run.sh (README, "On a GPU").
+gpu-bundle:
+	scripts/gpu-bundle.sh $(BUILD) out/gpu-bundle
 
 # Sanitizer build (clang): the whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer,
 # and the libFuzzer target over EXR loading, from one build folder. detect_leaks=0: PoCL and the

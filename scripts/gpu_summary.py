@@ -80,9 +80,13 @@ if logs:
         p(f"FAILED: {name}: {' / '.join(m.strip() for m in msg)}")
     if skipped:
         p()
-        p("Skipped, with the reason:")
+        p("Skipped, by reason:")
+        reasons = {}
         for name, msg in skipped:
-            p(f"- {name}: {msg}")
+            reasons.setdefault(msg, []).append(name)
+        for msg, names in sorted(reasons.items(), key=lambda kv: -len(kv[1])):
+            example = names[0] if len(names) == 1 else f"{len(names)} tests, e.g. {names[0]}"
+            p(f"- {msg} ({example})")
     p()
 
 # ---- deferred pass ---------------------------------------------------------------------------
