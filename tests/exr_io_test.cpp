@@ -399,6 +399,52 @@ TEST_F(ExrIoTest, DataWindowInsideDisplayWindowKeepsPixelPositions) {
     }
 }
 
+// Reading into a previous frame (ExrReadRequest::color_into / depth_into, as a sequence does)
+// gives the bytes of a fresh read and reuses the memory: with a full data window, and with a
+// smaller one, whose unstored pixels must come out as a new frame's, not as the old frame's.
+TEST_F(ExrIoTest, ReadingIntoAnOldFrameGivesTheFreshBytesAndReusesItsMemory) {
+  const Imath::Box2i display = box(0, 0, 15, 11);
+  const std::string full_file = path("full.exr"), windowed_file = path("windowed.exr");
+  for (const auto& [file, data] : {std::pair{full_file, display}, std::pair{windowed_file, box(2, 1, 9, 8)}}) {
+    std::vector<float> r, z;
+    for (int y = data.min.y; y <= data.max.y; ++y)
+      for (int x = data.min.x; x <= data.max.x; ++x) {
+        r.push_back(float(x) + 0.5f);
+        z.push_back(0.01f * float(x + 100 * y));
+      }
+    write_raw_exr(file, display, data,
+                  {{"R", Imf::FLOAT, r}, {"G", Imf::HALF, r}, {"B", Imf::FLOAT, r}, {"Z", Imf::FLOAT, z}});
+  }
+  fogcl::ExrReadRequest request;
+  request.depth_channel = "Z";
+  request.depth_outside = 0.75f;
+  for (const std::string& file : {full_file, windowed_file}) {
+    const fogcl::ExrInput fresh = fogcl::read_exr(file, request);
+    // An old frame of the same size full of other values (as the previous frame of a shot is).
+    ColorImage old_color(16, 12);
+    fogcl::DepthImage old_depth(16, 12, -7.0f);
+    std::fill(old_color.rgba32f(), old_color.rgba32f() + 4 * old_color.pixel_count(), 42.0f);
+    const void* color_memory = old_color.data();
+    const float* depth_memory = old_depth.data();
+    fogcl::ExrReadRequest into = request;
+    into.color_into = &old_color;
+    into.depth_into = &old_depth;
+    const fogcl::ExrInput reused = fogcl::read_exr(file, into);
+    EXPECT_EQ(reused.color.data(), color_memory) << file;
+    EXPECT_EQ(reused.depth.data(), depth_memory) << file;
+    ASSERT_EQ(reused.color.size_bytes(), fresh.color.size_bytes());
+    EXPECT_EQ(std::memcmp(reused.color.data(), fresh.color.data(), fresh.color.size_bytes()), 0) << file;
+    EXPECT_EQ(std::memcmp(reused.depth.data(), fresh.depth.data(), 4 * fresh.depth.pixel_count()), 0) << file;
+    // A frame of another size (or storage) is left alone and a new one is made.
+    ColorImage small(3, 3);
+    fogcl::ExrReadRequest other = request;
+    other.color_into = &small;
+    const fogcl::ExrInput made = fogcl::read_exr(file, other);
+    EXPECT_EQ(small.width(), 3);
+    EXPECT_EQ(std::memcmp(made.color.data(), fresh.color.data(), fresh.color.size_bytes()), 0) << file;
+  }
+}
+
 TEST_F(ExrIoTest, DataWindowOutsideDisplayWindowIsAnError) {
   const std::string file = path("data_outside.exr");
   write_raw_exr(file, box(0, 0, 3, 3), box(2, 2, 5, 3),

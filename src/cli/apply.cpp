@@ -133,8 +133,15 @@ struct FrameJob {
   ColorImage out;      // the fogged frame
 };
 
-// Reads a frame's color and depth and derives its camera (reader thread).
-void read_frame(const ApplyOptions& o, FrameJob& job) {
+// A fogged frame's inputs, kept for the next frame's read (ExrReadRequest::color_into).
+struct InputFrames {
+  ColorImage color;
+  DepthImage depth;
+};
+
+// Reads a frame's color and depth and derives its camera (reader thread). spare: frames to read
+// into when they fit (may be null).
+void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullptr) {
   const FramePaths& paths = job.paths;
   const DepthKind kind = parse_depth_kind(o.depth_kind);
   // Outside the depth's data window (and in empty deep pixels) there is nothing: background.
@@ -147,6 +154,10 @@ void read_frame(const ApplyOptions& o, FrameJob& job) {
   // Half output of half input: fog in half storage, so that f == 1 pixels keep their bits (§2).
   request.keep_half = o.pixel_type == "half";
   if (paths.depth.empty()) request.depth_channel = o.depth_channel;
+  if (spare != nullptr) {
+    request.color_into = &spare->color;
+    request.depth_into = &spare->depth;
+  }
   job.color = read_exr(paths.color, request);
   const ExrInput& color = job.color;
 
@@ -164,6 +175,7 @@ void read_frame(const ApplyOptions& o, FrameJob& job) {
     depth_request.depth_channel = o.depth_channel;
     depth_request.depth_single_channel_fallback = true;
     depth_request.depth_outside = outside;
+    if (spare != nullptr) depth_request.depth_into = &spare->depth;
     ExrInput d = read_exr(paths.depth, depth_request);
     if (!(d.windows == color.windows))
       throw Error(paths.depth + ": data/display window differs from " + paths.color +
@@ -173,25 +185,27 @@ void read_frame(const ApplyOptions& o, FrameJob& job) {
   to_raw_depth(job.depth, kind, job.params);
 }
 
-// Output frames that were written, kept for the next frames: a fresh 33 MB (1080p float) frame
-// costs its page faults and zeroing every time.
-class SpareFrames {
+// Frames that are done with (written outputs, fogged inputs), kept for the next frames: a fresh
+// frame costs its page faults and zeroing every time (33 MB for 1080p float color, 133 MB at 4K),
+// on the reader's thread for inputs. Two of each are enough for the pipeline's frames in flight.
+template <class Frames>
+class Spares {
  public:
-  void give(ColorImage image) {
+  void give(Frames frames) {
     std::lock_guard<std::mutex> lock(m_);
-    if (spares_.size() < 2) spares_.push_back(std::move(image));
+    if (spares_.size() < 2) spares_.push_back(std::move(frames));
   }
-  ColorImage take() {
+  Frames take() {
     std::lock_guard<std::mutex> lock(m_);
-    if (spares_.empty()) return ColorImage();
-    ColorImage image = std::move(spares_.back());
+    if (spares_.empty()) return Frames();
+    Frames frames = std::move(spares_.back());
     spares_.pop_back();
-    return image;
+    return frames;
   }
 
  private:
   std::mutex m_;
-  std::vector<ColorImage> spares_;
+  std::vector<Frames> spares_;
 };
 
 // The passes of one frame (fog thread; the only user of the backend and the volume stage).
@@ -238,8 +252,14 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
   } else {
     backend.apply(color.color, job.depth, job.out, params, settings);
   }
-  job.color.color = ColorImage();  // the inputs' pixels are not needed any more: memory stays bounded
+}
+
+// The fogged frame's input pixels are not needed any more: memory stays bounded.
+InputFrames take_inputs(FrameJob& job) {
+  InputFrames inputs{std::move(job.color.color), std::move(job.depth)};
+  job.color.color = ColorImage();
   job.depth = DepthImage();
+  return inputs;
 }
 
 // Writes a fogged frame (and its preview) (writer thread).
@@ -329,6 +349,7 @@ int run_apply(const ApplyOptions& o) {
     Backend backend(o.device);
     const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
     fog_frame(o, backend, job, o.verbose, volumes.get(), -1);
+    take_inputs(job);
     write_frame(o, job);
     return 0;
   }
@@ -357,17 +378,20 @@ int run_apply(const ApplyOptions& o) {
   int written = 0, last_written = -1;
   bool setup_printed = false;
 
+  Spares<ColorImage> spares;
+  Spares<InputFrames> spare_inputs;
   FramePipeline<FrameJob>::Stages stages;
   stages.read = [&](FrameJob& job) {
     const int f = job.frame;
     job.paths = {frame_path(color, f), o.depth_path.empty() ? "" : frame_path(depth, f), frame_path(out, f),
                  o.png_path.empty() ? "" : frame_path(png, f)};
-    read_frame(o, job);
+    InputFrames spare = spare_inputs.take();
+    read_frame(o, job, &spare);
   };
-  SpareFrames spares;
   stages.fog = [&](FrameJob& job) {
     job.out = spares.take();  // the passes reuse it when it has the frame's size and storage
     fog_frame(o, backend, job, o.verbose && !setup_printed, volumes.get(), job.frame);
+    spare_inputs.give(take_inputs(job));
     setup_printed = true;
   };
   stages.write = [&](FrameJob& job) {

@@ -143,6 +143,28 @@ Frame frame_of(const Source& s, int part, const ExrReadRequest& r, ExrWindows* w
   return f;
 }
 
+// Where a read does not write every pixel of the display-window frame (a smaller data window, a
+// deep part's empty pixels), the frame must start as a new one does.
+bool read_leaves_gaps(const Frame& f, bool deep) { return deep || f.data != f.display; }
+
+// The frame to read into: *into when it has the size and storage (its pixels reset where the read
+// leaves gaps), else a new one ((0, 0, 0, 0)).
+ColorImage color_frame(ColorImage* into, const Frame& f, ColorFormat format, bool gaps) {
+  if (into == nullptr || into->width() != f.width || into->height() != f.height || into->format() != format)
+    return ColorImage(f.width, f.height, format);
+  ColorImage image = std::move(*into);
+  if (gaps) std::memset(image.data(), 0, image.size_bytes());
+  return image;
+}
+
+DepthImage depth_frame(DepthImage* into, const Frame& f, float outside, bool gaps) {
+  if (into == nullptr || into->width() != f.width || into->height() != f.height)
+    return DepthImage(f.width, f.height, outside);
+  DepthImage image = std::move(*into);
+  if (gaps) std::fill(image.data(), image.data() + image.pixel_count(), outside);
+  return image;
+}
+
 // Reads `type` slices (or fills) for `names` into a frame with `stride` values per pixel.
 void read_flat(Source& s, int part, const Frame& f, void* frame, Imf::PixelType type, int stride,
                const std::vector<std::string>& names, const std::vector<double>& fill) {
@@ -360,7 +382,7 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
                     box_string(dh.displayWindow()) + ", data " + box_string(dh.dataWindow()) +
                     ") differ from the color part's: depth and color must cover the same pixels");
     }
-    out.depth = DepthImage(df.width, df.height, r.depth_outside);
+    out.depth = depth_frame(r.depth_into, df, r.depth_outside, read_leaves_gaps(df, is_deep(dh)));
     if (is_deep(dh))
       read_deep(s, out.depth_part, df, r, prefix, nullptr, out.depth.data(), name);
     else
@@ -386,7 +408,8 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
   for (const char* c : {"R", "G", "B", "A"})
     if (const Imf::Channel* channel = ch.channels().findChannel(prefix + c)) all_half = all_half && channel->type == Imf::HALF;
   const bool half = r.keep_half && all_half;
-  out.color = ColorImage(f.width, f.height, half ? ColorFormat::rgba16f : ColorFormat::rgba32f);  // (0, 0, 0, 0)
+  out.color = color_frame(r.color_into, f, half ? ColorFormat::rgba16f : ColorFormat::rgba32f,
+                          read_leaves_gaps(f, is_deep(ch)));
   if (is_deep(ch)) {
     out.deep = true;
     read_deep(s, out.color_part, f, r, prefix, out.color.rgba32f(), nullptr, "Z");
