@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds what the GPU machine needs and puts it in one folder to carry there.
 #   scripts/gpu-bundle.sh [BUILD_DIR] [BUNDLE_DIR]      (defaults: build, out/gpu-bundle)
-# The bundle: bin/ (the CLI, the test suite, both benchmarks), lib/ (every shared library they
+# The bundle: bin/ (the CLI, the test suite, both benchmarks, the sequence peer and generator), lib/ (every shared library they
 # load, glibc's own excepted: gpu-run.sh links only those the GPU machine lacks), gpu-run.sh and
 # gpu_summary.py. Then, on the GPU machine, from the bundle: ./gpu-run.sh RESULTS_DIR
 # (README, "On a GPU").
@@ -14,11 +14,13 @@ cd "$root"
 
 "$here/setup.sh" --bench
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" -j "$(nproc)" --target fogcl_cli fogcl_tests fogcl_bench fogcl_volume_bench
+cmake --build "$build" -j "$(nproc)" --target fogcl_cli fogcl_tests fogcl_bench fogcl_volume_bench \
+  fogcl_exr_peer fogcl_make_sequence
 
 rm -rf "$bundle"
 mkdir -p "$bundle/bin" "$bundle/lib"
-bins=("$build/src/fogcl" "$build/tests/fogcl_tests" "$build/bench/fogcl_bench" "$build/bench/fogcl_volume_bench")
+bins=("$build/src/fogcl" "$build/tests/fogcl_tests" "$build/bench/fogcl_bench" "$build/bench/fogcl_volume_bench"
+      "$build/bench/fogcl_exr_peer" "$build/bench/fogcl_make_sequence")
 cp "${bins[@]}" "$bundle/bin/"
 strip --strip-debug "$bundle"/bin/*
 
@@ -30,7 +32,7 @@ ldd "${bins[@]}" | awk '/=> \// {print $3}' | sort -u | while read -r lib; do
     *) cp -L "$lib" "$bundle/lib/" ;;
   esac
 done
-cp "$here/gpu-run.sh" "$here/gpu_summary.py" "$bundle/"
+cp "$here/gpu-run.sh" "$here/gpu_summary.py" "$root/bench/sequence_bench.py" "$bundle/"
 git rev-parse --short HEAD >"$bundle/COMMIT" 2>/dev/null || echo unknown >"$bundle/COMMIT"
 echo "bundle: $bundle ($(du -sh "$bundle" | cut -f1), commit $(cat "$bundle/COMMIT"))"
 ls "$bundle/bin" "$bundle/lib"

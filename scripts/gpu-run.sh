@@ -8,6 +8,8 @@
 #   tests  the whole test suite with FOGCL_DEVICE=gpu, in parallel shards (gtest XML per shard)
 #   bench  both benchmarks on the GPU (device-resident and host round trip, the device copy)
 #   pocl   the volumetric march on the machine's PoCL, 1 to all cores (POCL_MAX_PTHREAD_COUNT)
+#   sequence  fogcl apply on frame sequences against OpenEXR alone (sequence_bench.py; not in
+#          "all": minutes of I/O; SEQUENCE_ARGS adds its options, e.g. "--cases 4k-half-zip")
 # and writes RESULTS_DIR/summary.md from what they left (gpu_summary.py).
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -99,6 +101,14 @@ if want pocl; then
       'BM_VolumeDevice/integrator:[01]/divisor:2/noise_image:0/width:1920' --benchmark_repetitions=3 \
       --benchmark_report_aggregates_only=true
   done
+fi
+
+# --- Frame sequences: OpenEXR alone against fogcl apply, N threads pinned to N cores ----------
+if [ "${parts[0]}" = sequence ]; then
+  # shellcheck disable=SC2086
+  python3 "$here/sequence_bench.py" --bin "$bin" --out "$results/sequence" --data "$scratch/sequences" --pin \
+    ${SEQUENCE_ARGS:-} >"$results/sequence.txt" 2>&1 || { echo "sequence: failed (see sequence.txt)"; status=1; }
+  tail -n 40 "$results/sequence.txt"
 fi
 
 python3 "$here/gpu_summary.py" "$results" >"$results/summary.md" || status=1
