@@ -10,12 +10,25 @@
 //   BM_VolumeScalar/integrator/width   the scalar float path, one thread
 //   BM_VolumeNothingVisible   enqueue of a frame whose volumes are all culled: no kernel, the
 //        host-side cost of the call
+//   BM_VolumeOpenMP/integrator/width   the OpenMP-SIMD C++ peer of the march (2 threads, -O3
+//        -march=native, bench/volume_openmp_peer.cpp), half resolution; max_err of its target
+//        against the scalar double march at 480x270
+//   BM_VolumeScaling/steps/divisor/volumes   the OpenCL pass at 480x270 along three sweeps (steps
+//        8..256; full/half/quarter; 1..16 volumes): work = sum over target pixels of steps x the
+//        volumes the pixel's ray enters before the scene, ns_per_work = device time / work (flat
+//        if the cost grows as the work does; bench/plot_volume.py draws it)
+// BM_VolumeDevice also times a 2-thread memcpy of the frame's color and depth (memcpy2_ms) for
+// composite_vs_memcpy2 = composite time / that copy.
 // Widths: 480 (480x270: scalar and OpenCL in the same run) and 1920 (1080p, OpenCL only).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
+#include <thread>
 #include <tuple>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 
@@ -24,6 +37,9 @@
 #include "fogcl/volume_pass.h"
 #include "fogcl/volume_scalar.h"
 #include "runtime/clhpp.h"
+#include "volume/volume_formulas.h"
+#include "volume/volume_params.h"
+#include "volume_openmp_peer.h"
 
 namespace {
 
@@ -83,6 +99,59 @@ double event_ms(const cl::Event& a, cl_profiling_info from, const cl::Event& b, 
   return double(t1 - t0) * 1e-6;
 }
 
+// Median of 7 copies of the frame's color and depth with 2 threads [ms]: the composite's ceiling.
+double memcpy2_ms(const DemoFrame& f) {
+  std::vector<std::byte> color(f.color.size_bytes()), depth(f.depth.size_bytes());
+  const auto part = [&](int t) {
+    const std::size_t cb = color.size(), db = depth.size();
+    std::memcpy(color.data() + cb * t / 2, static_cast<const std::byte*>(f.color.data()) + cb * t / 2, cb / 2 + t * (cb % 2));
+    std::memcpy(depth.data() + db * t / 2, reinterpret_cast<const std::byte*>(f.depth.data()) + db * t / 2,
+                db / 2 + t * (db % 2));
+  };
+  std::vector<double> ms;
+  for (int i = 0; i < 7; ++i) {
+    const auto a = std::chrono::steady_clock::now();
+    std::thread second(part, 1);
+    part(0);
+    second.join();
+    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+// The march's work: over the target pixels, steps x the visible volumes whose sphere the pixel's
+// ray enters before the scene (the same ray, occluder and sphere test as the kernel).
+double march_work(const DemoFrame& f, const VolumeScene& s, const VolumeSettings& st) {
+  using namespace volume_formulas;
+  const detail::PackedVolumeFrame p = detail::pack_volume_frame(
+      f.color.width(), f.color.height(), f.params, s, st, f.color.format(), nullptr, 0, 0, max_eye_depth(f.depth, f.params));
+  const float* fr = p.frame.data();
+  const detail::VolumeVariant& v = p.variant;
+  const int scale = int(fr[VOL_F_SCALE]);
+  double hits = 0;
+  for (int ly = 0; ly < p.low_height; ++ly)
+    for (int lx = 0; lx < p.low_width; ++lx) {
+      const float eye = vol_block_eye_depth<float>(f.depth.data(), lx, ly, scale, f.color.width(), f.color.height(),
+                                                   int(v.projection), v.reversed_z, fr[VOL_F_ZX], fr[VOL_F_ZY],
+                                                   fr[VOL_F_NEAR], fr[VOL_F_FAR]);
+      glm::vec3 origin, dir;
+      float t_per_eye;
+      vol_pixel_ray<float>(float(lx * scale) + 0.5f * float(scale), float(ly * scale) + 0.5f * float(scale), fr,
+                           int(v.projection), &origin, &dir, &t_per_eye);
+      const float t_scene = vol_scene_distance<float>(eye, fr[VOL_F_NEAR], t_per_eye);
+      for (std::size_t i = 0; i < p.visible.size(); ++i) {
+        const float* vol = p.volumes.data() + i * VOL_V_STRIDE;
+        float t0, t1;
+        if (vol_sphere_hit<float>(origin, dir, glm::vec3(vol[VOL_V_CENTER], vol[VOL_V_CENTER + 1], vol[VOL_V_CENTER + 2]),
+                                  vol[VOL_V_RADIUS], &t0, &t1) &&
+            t0 < t_scene)
+          hits += 1;
+      }
+    }
+  return hits * st.steps;
+}
+
 void BM_VolumeDevice(benchmark::State& state) {
   const auto integrator = VolumeIntegrator(state.range(0));
   const int divisor = int(state.range(1)), width = int(state.range(3));
@@ -122,6 +191,9 @@ void BM_VolumeDevice(benchmark::State& state) {
   state.counters["march_ms"] = march_ms / n;
   state.counters["composite_ms"] = composite_ms / n;
   state.counters["steps_x_pixels_per_s"] = kSteps * low_pixels / (march_ms / n * 1e-3);
+  const double copy_ms = memcpy2_ms(f);
+  state.counters["memcpy2_ms"] = copy_ms;
+  state.counters["composite_vs_memcpy2"] = composite_ms / n / copy_ms;
   if (width == 480) {
     ColorImage result(fb.width, fb.height);
     queue.enqueueReadBuffer(out, CL_TRUE, 0, result.size_bytes(), result.data());
@@ -153,6 +225,83 @@ void BM_VolumeScalar(benchmark::State& state) {
   state.counters["steps_x_pixels_per_s"] =
       benchmark::Counter(kSteps * low_pixels * double(state.iterations()), benchmark::Counter::kIsRate);
   state.counters["max_err"] = max_abs_rgb_error(out, reference(integrator, 2));
+}
+
+void BM_VolumeOpenMP(benchmark::State& state) {
+  const auto integrator = VolumeIntegrator(state.range(0));
+  const int width = int(state.range(1));
+  const DemoFrame& f = frame(width);
+  const VolumeScene s = scene(integrator);
+  const VolumeSettings st = settings(integrator, 2, false);
+  std::vector<float> low;
+  std::size_t pixels = 0;
+  for (auto _ : state) pixels = bench::openmp_simd_march(f.color, f.depth, f.params, s, st, 2, low);
+  state.counters["steps_x_pixels_per_s"] =
+      benchmark::Counter(kSteps * double(pixels) * double(state.iterations()), benchmark::Counter::kIsRate);
+  if (width == 480) {
+    const VolumeResult<double>& ref = reference(integrator, 2);
+    double err = 0;
+    for (std::size_t i = 0; i < low.size(); ++i) err = std::max(err, std::fabs(double(low[i]) - ref.low[i]));
+    state.counters["max_err"] = err;  // of the target (premultiplied RGB and coverage)
+  }
+}
+
+// 16 volumes: the demo's four, and copies shifted along the ground (the sweep takes the first n).
+std::vector<FogVolume> many_volumes(int n) {
+  const std::vector<FogVolume> demo = demo_fog_volumes(VolumeIntegrator::stylized);
+  std::vector<FogVolume> out;
+  for (int i = 0; out.size() < std::size_t(n); ++i) {
+    FogVolume v = demo[std::size_t(i) % demo.size()];
+    v.center += glm::vec3(1.5f * float(i / int(demo.size())), 0.0f, -2.0f * float(i / int(demo.size())));
+    out.push_back(v);
+  }
+  return out;
+}
+
+void BM_VolumeScaling(benchmark::State& state) {
+  const int steps = int(state.range(0)), divisor = int(state.range(1)), count = int(state.range(2));
+  const DemoFrame& f = frame(480);
+  VolumeScene s = scene(VolumeIntegrator::stylized);
+  s.volumes = many_volumes(count);
+  VolumeSettings st = settings(VolumeIntegrator::stylized, divisor, false);
+  st.steps = steps;
+  st.adaptive_steps = false;  // the work is steps per entered volume
+  VolumePass pass(runtime());
+  pass.prepare(f.params, s, st, ColorFormat::rgba32f);
+  const cl::Context ctx = wrap(runtime().context());
+  const cl::CommandQueue queue(ctx, wrap(runtime().device()), CL_QUEUE_PROFILING_ENABLE);
+  const cl::Buffer color(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.color.size_bytes(), const_cast<void*>(f.color.data()));
+  const cl::Buffer depth(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.depth.size_bytes(), const_cast<float*>(f.depth.data()));
+  const cl::Buffer out(ctx, CL_MEM_READ_WRITE, f.color.size_bytes());
+  FrameBuffers fb;
+  fb.width = f.color.width();
+  fb.height = f.color.height();
+  fb.color_in = color();
+  fb.depth = depth();
+  fb.color_out = out();
+  const float max_eye = max_eye_depth(f.depth, f.params);
+  adopt(pass.enqueue(queue(), fb, f.params, s, st, nullptr, {}, max_eye)).wait();
+  double total_ms = 0;
+  for (auto _ : state) {
+    cl::Event before;
+    queue.enqueueMarkerWithWaitList(nullptr, &before);
+    const cl::Event done = adopt(pass.enqueue(queue(), fb, f.params, s, st, nullptr, {}, max_eye));
+    done.wait();
+    const double ms = event_ms(before, CL_PROFILING_COMMAND_END, done, CL_PROFILING_COMMAND_END);
+    total_ms += ms;
+    state.SetIterationTime(ms * 1e-3);
+  }
+  const double work = march_work(f, s, st);
+  state.counters["work"] = work;
+  state.counters["ns_per_work"] = total_ms / double(state.iterations()) * 1e6 / std::max(work, 1.0);
+}
+
+void ScalingArgs(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"steps", "divisor", "volumes"});
+  for (int steps : {8, 16, 32, 64, 128, 256}) b->Args({steps, 2, 4});
+  for (int divisor : {1, 4}) b->Args({64, divisor, 4});
+  for (int volumes : {1, 2, 8, 16}) b->Args({64, 2, volumes});
+  b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.3);
 }
 
 void BM_VolumeNothingVisible(benchmark::State& state) {
@@ -190,9 +339,15 @@ BENCHMARK(BM_VolumeHostCall)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeScalar)
     ->ArgNames({"integrator", "width"})
-    ->ArgsProduct({{0, 1}, {480}})
+    ->ArgsProduct({{0, 1}, {480, 1920}})
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
+BENCHMARK(BM_VolumeOpenMP)
+    ->ArgNames({"integrator", "width"})
+    ->ArgsProduct({{0, 1}, {480, 1920}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
+BENCHMARK(BM_VolumeScaling)->Apply(ScalingArgs);
 BENCHMARK(BM_VolumeNothingVisible)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();
