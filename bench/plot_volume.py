@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Draws how the volumetric pass's cost grows with its work, from a fogcl_volume_bench JSON:
-   bench/plot_volume.py VOLUME.json OUT.png
+   bench/plot_volume.py VOLUME.json [MORE.json ...] OUT.png   (a later file's rows replace an earlier's)
 Left: device time against the march's work (steps x volumes entered, summed over target pixels)
 for the BM_VolumeScaling sweeps (step count, resolution, number of volumes); a cost that grows as
 the work does lies on one line through the origin. Right: the march's steps x pixels per second
@@ -32,8 +32,12 @@ def ms(b):
 
 
 def main():
-    src, dst = sys.argv[1], sys.argv[2]
-    bench, ctx = rows(src)
+    dst = sys.argv[-1]
+    by_name, ctx = {}, {}
+    for src in sys.argv[1:-1]:
+        found, ctx = rows(src)
+        by_name.update((b["name"].replace("/real_time", ""), b) for b in found)
+    bench = list(by_name.values())
     fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.8))
 
     scaling = [b for b in bench if b["name"].startswith("BM_VolumeScaling/")]
@@ -58,7 +62,8 @@ def main():
     left.legend(fontsize=8)
     left.grid(alpha=0.3)
 
-    names, rates = [], []
+    names, rates, colors = [], [], []
+    palette = {"OpenCL (PoCL)": "tab:blue", "OpenMP-SIMD peer": "tab:orange", "scalar, 1 thread": "tab:gray"}
     for integ, label in ((0, "stylized"), (1, "physical")):
         for prefix, path in (("BM_VolumeDevice/", "OpenCL (PoCL)"), ("BM_VolumeOpenMP/", "OpenMP-SIMD peer"),
                              ("BM_VolumeScalar/", "scalar, 1 thread")):
@@ -68,7 +73,8 @@ def main():
                         and a.get("divisor", 2) == 2 and a.get("noise_image", 0) == 0):
                     names.append(f"{label}\n{path}")
                     rates.append(b["steps_x_pixels_per_s"] / 1e6)
-    right.barh(names[::-1], rates[::-1], color=["tab:blue", "tab:orange", "tab:gray"] * 2)
+                    colors.append(palette[path])
+    right.barh(names[::-1], rates[::-1], color=colors[::-1])
     for y, r in enumerate(rates[::-1]):
         right.text(r, y, f" {r:.1f}", va="center", fontsize=8)
     right.set_xlabel("march: million steps x target pixels per second")
