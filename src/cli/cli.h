@@ -69,7 +69,9 @@ struct ReportCliOptions {
   int height = 360;
   int runs = 9;
   std::string device;
+  bool volumetric = false;  // --volumetric: the volumetric pass's report (fogcl/volume_report.h)
 };
 int run_report(const ReportCliOptions& options);
+int run_volume_report_cli(const ReportCliOptions& options);
 
 }  // namespace fogcl::cli
