@@ -66,7 +66,10 @@ int run_volume_report_cli(const ReportCliOptions& o) {
   std::size_t last_pct = 0;
   options.progress = [&](std::size_t done, std::size_t total) {
     const std::size_t pct = 100 * done / total;
-    if (pct / 10 != last_pct / 10 || done == total) std::fprintf(stderr, "  %zu/%zu rows\n", done, total);
+    if (done == 0)
+      std::fprintf(stderr, "%zu rows; the references first\n", total);
+    else if (pct / 10 != last_pct / 10 || done == total)
+      std::fprintf(stderr, "  %zu/%zu rows\n", done, total);
     last_pct = pct;
   };
   std::printf("device: %s\nframes: %dx%d, median of %d runs (device time from profiling events); reference: the "

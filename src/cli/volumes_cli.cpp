@@ -576,7 +576,21 @@ void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImag
                         int sequence_frame, bool verbose) {
   const VolumeScene scene = scene_for(sequence_frame);
   if (options_.max_error_given && (!chosen_ || chosen_storage_ != in.format())) {
-    const VolumeQualityChoice c = choose_volume_quality(*runtime_, settings_, in.format(), options_.max_error);
+    // A missing measurement takes minutes (the 4096-step references, then every variant): say so.
+    VolumeBudgetOptions budget;
+    std::size_t last = 0;
+    budget.measure.progress = [&last](std::size_t done, std::size_t total) {
+      if (done == 0)
+        std::fprintf(stderr,
+                     "fogcl: --max-error: measuring %zu volumetric variants x scenes once for this device (the "
+                     "references first); the result is cached\n",
+                     total);
+      else if (10 * done / total != 10 * last / total)
+        std::fprintf(stderr, "  %zu/%zu\n", done, total);
+      last = done;
+    };
+    const VolumeQualityChoice c =
+        choose_volume_quality(*runtime_, settings_, in.format(), options_.max_error, budget);
     settings_ = c.settings;
     chosen_ = true;
     chosen_storage_ = in.format();

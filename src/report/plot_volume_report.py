@@ -105,6 +105,38 @@ if len(panels) > len(scenes):
     ax.set_ylabel("max |color - float64 4096 steps|")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+# What --max-error sees: per quality variant, the worst max error over the scenes against the sum
+# of their times (rgba32f), and the fastest variant meeting each budget on its Pareto front.
+if len(panels) < nrows * cols:
+    ax = axes[len(panels) // cols][len(panels) % cols]
+    panels.append("budget")
+    for integrator in ("stylized", "physical"):
+        agg = {}
+        for r in rows:
+            if r["integrator"] != integrator or r["storage"] != "rgba32f":
+                continue
+            key = (r["steps"], r["resolution"], r["upsampling"], r["noise"])
+            e = err(r["max_abs_err"])
+            worst, total = agg.get(key, (0.0, 0.0))
+            agg[key] = (max(worst, e if e is not None else float("inf")), total + float(r["time_ms"]))
+        pts = []
+        for (steps, res, up, noise), (e, t) in agg.items():
+            color = COLOR.get((res, up), "gray")
+            ax.scatter([t], [e], s=18, marker=MARKER[integrator], color=color, alpha=0.75)
+            pts.append((t, e))
+        front, best = [], float("inf")
+        for t, e in sorted(pts):
+            if e < best:
+                front.append((t, e))
+                best = e
+        if len(front) > 1:
+            ax.plot([p[0] for p in front], [p[1] for p in front], color=FRONT[integrator], lw=0.9, ls="--", zorder=0)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_title("what --max-error sees: worst over the scenes (rgba32f)", fontsize=10)
+    ax.set_xlabel("device time, sum over the scenes [ms]")
+    ax.set_ylabel("worst max |color - float64|")
+    ax.grid(True, which="both", alpha=0.3)
 for j in range(len(panels), nrows * cols):
     axes[j // cols][j % cols].axis("off")
 fig.legend(list(legend.values()), list(legend.keys()), loc="lower center", ncol=4, fontsize=8, frameon=False)

@@ -216,34 +216,6 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
       std::find(integrators.begin(), integrators.end(), VolumeIntegrator::physical) == integrators.end())
     integrators.push_back(VolumeIntegrator::physical);  // the Riemann rows' reference
 
-  // The references first, in threads (one per scene x integrator, at most the machine's cores at
-  // once); the timed device runs come after, on a quiet machine.
-  std::map<std::pair<std::string, int>, VolumeResult<double>> refs;
-  {
-    const auto t0 = std::chrono::steady_clock::now();
-    std::vector<std::pair<std::string, VolumeIntegrator>> jobs;
-    for (const std::string& s : scenes)
-      for (VolumeIntegrator i : integrators) jobs.emplace_back(s, i);
-    const std::size_t threads = std::max(1u, std::thread::hardware_concurrency());
-    for (std::size_t at = 0; at < jobs.size(); at += threads) {
-      std::vector<std::future<VolumeResult<double>>> running;
-      for (std::size_t j = at; j < std::min(jobs.size(), at + threads); ++j)
-        running.push_back(std::async(std::launch::async, [&, j] {
-          VolumeScene scene = base;
-          scene.volumes = scene_volumes(jobs[j].first, jobs[j].second);
-          VolumeSettings s;
-          s.integrator = jobs[j].second;
-          s.steps = o.reference_steps;
-          s.resolution_divisor = 1;
-          s.jitter = false;
-          return volumes_scalar<double>(frame.color, frame.depth, frame.params, scene, s);
-        }));
-      for (std::size_t j = at; j < std::min(jobs.size(), at + threads); ++j)
-        refs.emplace(std::make_pair(jobs[j].first, int(jobs[j].second)), running[j - at].get());
-    }
-    report.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
-
   struct Job {
     std::string scene;
     VolumeSettings settings;
@@ -276,6 +248,36 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
         s.resolution_divisor = 1;
         jobs.push_back({scene, s, ColorFormat::rgba32f});
       }
+  }
+
+  if (o.progress) o.progress(0, jobs.size());
+
+  // The references first, in threads (one per scene x integrator, at most the machine's cores at
+  // once); the timed device runs come after, on a quiet machine.
+  std::map<std::pair<std::string, int>, VolumeResult<double>> refs;
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<std::pair<std::string, VolumeIntegrator>> refs_to_do;
+    for (const std::string& s : scenes)
+      for (VolumeIntegrator i : integrators) refs_to_do.emplace_back(s, i);
+    const std::size_t threads = std::max(1u, std::thread::hardware_concurrency());
+    for (std::size_t at = 0; at < refs_to_do.size(); at += threads) {
+      std::vector<std::future<VolumeResult<double>>> running;
+      for (std::size_t j = at; j < std::min(refs_to_do.size(), at + threads); ++j)
+        running.push_back(std::async(std::launch::async, [&, j] {
+          VolumeScene scene = base;
+          scene.volumes = scene_volumes(refs_to_do[j].first, refs_to_do[j].second);
+          VolumeSettings s;
+          s.integrator = refs_to_do[j].second;
+          s.steps = o.reference_steps;
+          s.resolution_divisor = 1;
+          s.jitter = false;
+          return volumes_scalar<double>(frame.color, frame.depth, frame.params, scene, s);
+        }));
+      for (std::size_t j = at; j < std::min(refs_to_do.size(), at + threads); ++j)
+        refs.emplace(std::make_pair(refs_to_do[j].first, int(refs_to_do[j].second)), running[j - at].get());
+    }
+    report.reference_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
   VolumePass pass(runtime);

@@ -30,7 +30,8 @@ struct VolumeReportOptions {
                                     // resolution, buffer noise, rgba32f), against the physical reference
   int reference_steps = 4096;       // the reference march's steps, in [1, 4096]
   std::vector<std::string> scenes;  // names from volume_report_scene_names(); empty = all
-  std::function<void(std::size_t done, std::size_t total)> progress;  // after each row, when set
+  // When set: called with done = 0 before the references, then after each row.
+  std::function<void(std::size_t done, std::size_t total)> progress;
 };
 
 // One (scene, variant) measurement; errors against the reference over every pixel's R, G, B.
