@@ -313,5 +313,29 @@ TEST(VolumeErrorBudgetCli, MaxErrorPicksTheVariantAndExplicitFlagsConflict) {
   EXPECT_FALSE(fs::exists(dir + "/tiny.exr"));
 }
 
+// fogcl report's volumetric flags: bad values and misplaced flags are one line, exit 1, before
+// any measurement.
+TEST(VolumeReportCli, BadFlagsAreOneLineErrors) {
+  const std::string out = fresh_dir("volume-report-cli");
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {"--volumetric --device scalar", "the scalar path (--device scalar) has none"},
+      {"--volumetric --integrators riemann", "--integrators: 'riemann' is not one of stylized, physical"},
+      {"--volumetric --runs 2 --device " + cli_device(), "runs must be >= 3 for a median (got 2)"},
+      {"--volumetric --scenes fog --device " + cli_device(), "scene 'fog' is not one of demo, dense, thin, inside"},
+      {"--steps 8", "--steps selects volumetric variants; it needs --volumetric"},
+      {"--runs 5", "--runs must be >= 7 for the deferred report (got 5)"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli("report --out " + out + " " + c.args);
+    std::printf("[ message  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << ": " << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << c.args << ": " << r.output;
+    EXPECT_FALSE(fs::exists(out + "/volume-report.csv")) << c.args;
+  }
+}
+
 }  // namespace
 }  // namespace fogcl::test

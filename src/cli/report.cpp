@@ -55,14 +55,28 @@ int run_report(const ReportCliOptions& o) {
 int run_volume_report_cli(const ReportCliOptions& o) {
   namespace fs = std::filesystem;
   fs::create_directories(o.out_dir);
-  const std::string resolved = resolve_device_choice(o.device);
-  if (resolved == "scalar")
-    throw Error("fogcl report --volumetric measures OpenCL kernel variants; the scalar path (--device scalar) has none");
-  const Runtime runtime(resolved);
   VolumeReportOptions options;
   options.width = o.width;
   options.height = o.height;
   options.runs = o.runs;
+  if (!o.steps.empty()) options.steps = o.steps;
+  options.scenes = o.scenes;  // the library names a scene it does not know
+  if (!o.integrators.empty()) {
+    options.integrators.clear();
+    for (const std::string& name : o.integrators) {
+      if (name == "stylized")
+        options.integrators.push_back(VolumeIntegrator::stylized);
+      else if (name == "physical")
+        options.integrators.push_back(VolumeIntegrator::physical);
+      else
+        throw Error("--integrators: '" + name + "' is not one of stylized, physical");
+    }
+  }
+  validate(options);  // bad options are one line, before the device opens
+  const std::string resolved = resolve_device_choice(o.device);
+  if (resolved == "scalar")
+    throw Error("fogcl report --volumetric measures OpenCL kernel variants; the scalar path (--device scalar) has none");
+  const Runtime runtime(resolved);
   std::size_t last_pct = 0;
   options.progress = [&](std::size_t done, std::size_t total) {
     const std::size_t pct = 100 * done / total;

@@ -64,6 +64,10 @@ struct VolumeReport {
 // "inside" (the camera inside one noisy volume). The demo scene's frame, camera and light.
 std::vector<std::string> volume_report_scene_names();
 
+// Throws fogcl::Error naming the value and the rule for bad options (all but what depends on the
+// device: image noise sampling needs image support).
+void validate(const VolumeReportOptions& options);
+
 // Runs every variant of `options` on the runtime's device. Throws fogcl::Error for bad options
 // (naming the value and the rule), fogcl::ClError for OpenCL failures.
 VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions& options = {});
