@@ -43,6 +43,7 @@
 /* Integrators (VOL_INTEGRATOR, VolumeIntegrator). */
 #define VOL_STYLIZED 1
 #define VOL_PHYSICAL 2
+#define VOL_RIEMANN 3 /* the physical model with the textbook left Riemann sum (comparison only) */
 
 /* The per-frame array (src/volume/volume_params.cpp packs it): camera, light, shadow map. */
 #define VOL_F_EYE 0          /* world position of the camera (3) */

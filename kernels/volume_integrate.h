@@ -135,11 +135,15 @@ VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, VOL_REAL cos_theta, VO
  * piecewise-constant media at any d: with albedo 1 and unit light, I + T = 1 to rounding. The
  * (1 - e^x) is -expm1, so thin media keep their digits, and nothing divides by sigma_t but the
  * sigma_t-weighted mean source / sigma_t of the volumes' albedo * L, taken only where sigma_t > 0
- * (the textbook (S - S e^(-sigma_t d)) / sigma_t form is 0 / 0 in clear air). */
+ * (the textbook (S - S e^(-sigma_t d)) / sigma_t form is 0 / 0 in clear air).
+ * riemann != 0 (VOL_RIEMANN, for comparison only: fogcl report --volumetric, the stiffness test)
+ * replaces the segment's exact weight by the textbook left Riemann sum I += T * source * d with T
+ * at the segment's start: not energy-conserving, it overshoots by up to sigma_t d when
+ * sigma_t d >> 1. */
 VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL jitter,
                            VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
                            VOL_NOISE_PARAM, int noise_size, VOL_GLOBAL const float* shadow_map,
-                           int steps, int features) {
+                           int steps, int features, int riemann) {
   VOL_REAL t_in[VOL_MAX_VOLUMES], t_out[VOL_MAX_VOLUMES];
   VOL_REAL start = (VOL_REAL)INFINITY;
   VOL_UINT hit = 0u;
@@ -188,7 +192,8 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
           const VOL_REAL sigma_t = vol_physical_sample(p, t, cos_theta, lit, mask, vols, count, frame, noise,
                                                        noise_size, features, &source);
           if (!(sigma_t > (VOL_REAL)0)) continue;
-          const VOL_REAL scatter = -expm1(-sigma_t * seg) * exp(-depth) / sigma_t;
+          const VOL_REAL scatter =
+              riemann ? seg * exp(-depth) : -expm1(-sigma_t * seg) * exp(-depth) / sigma_t;
           i_r += source.x * scatter;
           i_g += source.y * scatter;
           i_b += source.z * scatter;
@@ -221,9 +226,9 @@ VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buff
                 &t_per_eye);
   const VOL_REAL t_scene = vol_scene_distance(eye_depth, near_plane, t_per_eye);
   const float j = vol_jitter((VOL_UINT)lx, (VOL_UINT)ly, frame_index);
-  if (integrator == VOL_PHYSICAL)
+  if (integrator != VOL_STYLIZED)
     return vol_physical(origin, dir, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame, noise,
-                        noise_size, shadow_map, steps, features);
+                        noise_size, shadow_map, steps, features, integrator == VOL_RIEMANN);
   /* stylized: each volume drawn over the target in the order given, with the seed's blend
    * (SrcAlpha, OneMinusSrcAlpha; One, OneMinusSrcAlpha): premultiplied colour and coverage. */
   VOL_V4 target = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);

@@ -3,7 +3,7 @@
  * ceil(H / s)). The maths is in the shared headers, which the C++ paths compile too.
  *
  * Variant switches (the host's volume_march_options(); none is optional):
- *   VOL_INTEGRATOR   1 stylized, 2 physical
+ *   VOL_INTEGRATOR   1 stylized, 2 physical, 3 the physical model's textbook Riemann sum (comparison)
  *   VOL_STEPS        march steps per ray
  *   VOL_FEATURES     bit set of VOL_FEATURE_* (noise, detail, fades, shadow map, adaptive steps)
  *   VOL_JITTER       1: per-ray jitter from (pixel, frame index); 0: none

@@ -14,8 +14,10 @@ namespace {
 
 // One volume of constant extinction on a unit chord: the ray from the origin along +z through a
 // sphere of radius 1/2 touching the origin; albedo 1, ambient 1, no light: L = 1 everywhere.
+// riemann: the textbook left Riemann sum I += T sigma_t d, T *= e^(-sigma_t d) of the shared march
+// (VOL_RIEMANN) instead of the exact segment weight.
 template <class T>
-std::array<T, 2> unit_chord(double sigma_t, int steps) {
+std::array<T, 2> unit_chord(double sigma_t, int steps, bool riemann = false) {
   std::array<float, VOL_F_COUNT> frame{};
   frame[VOL_F_LIGHT_DIR + 1] = 1.0f;  // light color stays 0
   std::array<float, VOL_V_STRIDE> vol{};
@@ -25,19 +27,9 @@ std::array<T, 2> unit_chord(double sigma_t, int steps) {
   for (int k = 0; k < 3; ++k) vol[VOL_V_ALBEDO + k] = vol[VOL_V_AMBIENT + k] = 1.0f;
   const glm::vec<3, T> origin(0), dir(0, 0, 1);
   const glm::vec<4, T> r = volume_formulas::vol_physical<T>(origin, dir, T(INFINITY), T(0.5), vol.data(), 1,
-                                                            frame.data(), nullptr, 0, nullptr, steps, 0);
+                                                            frame.data(), nullptr, 0, nullptr, steps, 0,
+                                                            int(riemann));
   return {r.x, r.w};  // I (one channel), A = 1 - T
-}
-
-// The textbook left Riemann sum of the same integral: I += T sigma_t d, T *= e^(-sigma_t d).
-double riemann(double sigma_t, int steps) {
-  const double d = 1.0 / steps;
-  double i = 0, t = 1;
-  for (int k = 0; k < steps; ++k) {
-    i += t * sigma_t * d;
-    t *= std::exp(-sigma_t * d);
-  }
-  return i;
 }
 
 TEST(VolumeStiffness, EnergyConservedFromClearAirToOpaque) {
@@ -64,8 +56,13 @@ TEST(VolumeStiffness, EnergyConservedFromClearAirToOpaque) {
       if (x > 0 && x * steps < 1e-3) {
         EXPECT_NEAR(double(f[1]), -std::expm1(-sigma), 1e-6 * -std::expm1(-sigma)) << "thin, sigma_t*d " << x;
       }
-      const double naive = riemann(sigma, steps) - (1.0 - std::exp(-sigma));
+      const double naive = unit_chord<double>(sigma, steps, true)[0] - (1.0 - std::exp(-sigma));
       std::printf("  %10.0e %14.3g %14.3g %14.3g %14.3g\n", x, double(f[0]) + tf - 1.0, d[0] + td - 1.0, tf, naive);
+      // The textbook sum overshoots by about sigma_t d once a segment is opaque (fogcl report
+      // --volumetric shows it on its dense scene); the exact weight above stays within 1e-6.
+      if (x >= 10.0) {
+        EXPECT_GT(naive, 0.5 * x) << "Riemann, sigma_t*d " << x;
+      }
       ++checked;
     }
   }

@@ -104,6 +104,10 @@ FogSettings pass_settings(const ApplyOptions& o, Backend& backend, ColorFormat s
   }
   if (backend.is_scalar())
     throw Error("--max-error picks an OpenCL kernel variant; the scalar path (--device scalar) has none");
+  if (s.mode == FogMode::off) {  // only the volumes run: --max-error picks their variant alone
+    *why = "precision: not chosen (--mode off: no deferred fog runs; --max-error picks the volumetric variant)\n";
+    return s;
+  }
   const PrecisionChoice c = choose_precision_detailed(*backend.runtime(), storage, o.max_error);
   s.precision = c.precision;
   char buf[256];

@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "cli/volumes_cli.h"
 #include "fogcl/fogcl.h"
@@ -69,7 +70,11 @@ struct ReportCliOptions {
   int height = 360;
   int runs = 9;
   std::string device;
+  bool volumetric = false;  // --volumetric: the volumetric pass's report (fogcl/volume_report.h)
+  std::vector<int> steps;   // --volumetric: only these (empty: the report's default)
+  std::vector<std::string> scenes, integrators;
 };
 int run_report(const ReportCliOptions& options);
+int run_volume_report_cli(const ReportCliOptions& options);
 
 }  // namespace fogcl::cli

@@ -105,7 +105,9 @@ int main(int argc, char** argv) {
   apply_cmd->add_option("--max-error", ap.max_error,
                         "Error budget: use the fastest precision variant whose measured worst color error "
                         "(fogcl report's scenes, this device; measured once, cached under "
-                        "$XDG_CACHE_HOME/fogcl) is <= E; not with --precision");
+                        "$XDG_CACHE_HOME/fogcl) is <= E; not with --precision. With --volumes it also picks "
+                        "the volumetric steps, resolution, upsampling and noise sampling the same way "
+                        "(fogcl report --volumetric's scenes); not with those flags");
   apply_cmd->add_option("--device", ap.device, kDeviceHelp);
   apply_cmd->add_flag("--verbose", ap.verbose, "Print the device, the kernel variant chosen and why");
   fogcl::cli::add_volume_options(*apply_cmd, ap.volumes);
@@ -119,9 +121,19 @@ int main(int argc, char** argv) {
   report_cmd->add_option("--device", report.device, kDeviceHelp);
   report_cmd->add_option("--width", report.width, "Frame width [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
   report_cmd->add_option("--height", report.height, "Frame height [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
-  report_cmd->add_option("--runs", report.runs, "Timed runs per row (the median is reported), >= 7")
-      ->check(CLI::Range(7, 1000))
-      ->capture_default_str();
+  report_cmd->add_option("--runs", report.runs,
+                         "Timed runs per row (the median is reported), >= 7 (default 9); --volumetric: >= 3 "
+                         "(default 5)");
+  report_cmd->add_flag("--volumetric", report.volumetric,
+                       "The volumetric pass instead: steps x resolution x upsampling x noise sampling x integrator x "
+                       "storage on four volume scenes against the scalar<double> march at 4096 steps (default frame "
+                       "160x90); writes volume-report.csv, .json and .png");
+  report_cmd->add_option("--steps", report.steps, "--volumetric: only these step counts, e.g. 16,32 (default all six)")
+      ->delimiter(',');
+  report_cmd->add_option("--scenes", report.scenes, "--volumetric: only these of demo,dense,thin,inside")
+      ->delimiter(',');
+  report_cmd->add_option("--integrators", report.integrators, "--volumetric: only these of stylized,physical")
+      ->delimiter(',');
 
   try {
     app.parse(argc, argv);
@@ -131,7 +143,21 @@ int main(int argc, char** argv) {
 
   try {
     if (*demo_cmd) return fogcl::cli::run_demo(demo);
-    if (*report_cmd) return fogcl::cli::run_report(report);
+    if (*report_cmd) {
+      if (report.runs > 1000) throw fogcl::Error("--runs must be <= 1000 (got " + std::to_string(report.runs) + ")");
+      if (report.volumetric) {  // its own defaults: the 4096-step references must take seconds
+        if (report_cmd->count("--width") == 0) report.width = 160;
+        if (report_cmd->count("--height") == 0) report.height = 90;
+        if (report_cmd->count("--runs") == 0) report.runs = 5;
+        return fogcl::cli::run_volume_report_cli(report);
+      }
+      for (const char* flag : {"--steps", "--scenes", "--integrators"})
+        if (report_cmd->count(flag) > 0)
+          throw fogcl::Error(std::string(flag) + " selects volumetric variants; it needs --volumetric");
+      if (report.runs < 7) throw fogcl::Error("--runs must be >= 7 for the deferred report (got " +
+                                              std::to_string(report.runs) + ")");
+      return fogcl::cli::run_report(report);
+    }
     fogcl::cli::note_given_volume_flags(*apply_cmd, ap.volumes);
     // With volumes the deferred fog is optional: no --mode runs only the volumetric pass.
     if (apply_cmd->count("--mode") == 0) {
@@ -140,6 +166,8 @@ int main(int argc, char** argv) {
     }
     ap.precision_given = apply_cmd->count("--precision") > 0;
     ap.max_error_given = apply_cmd->count("--max-error") > 0;
+    ap.volumes.max_error_given = ap.max_error_given && !ap.volumes.volumes_path.empty();
+    ap.volumes.max_error = ap.max_error;
     if (apply_cmd->count("--threads") > 0 && ap.threads < 1)
       throw fogcl::Error("--threads must be between 1 and 4096 (got " + std::to_string(ap.threads) + ")");
     if (apply_cmd->count("--far") == 0 && !ap.infinite_far)

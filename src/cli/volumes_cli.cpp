@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "fogcl/exr_io.h"
+#include "fogcl/volume_report.h"
 #include "fogcl/volume_scalar.h"
 
 namespace fogcl::cli {
@@ -539,7 +540,21 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     s.shadow_ = read_shadow_map(o.shadow_map_path, m, o.shadow_reversed_z);
   }
 
+  if (o.max_error_given) {
+    // The budget picks these four; a flag that names one too is a contradiction, not a hint.
+    for (const char* flag : {"--steps", "--volume-resolution", "--upsample", "--noise-sampling"})
+      if (given(o, flag))
+        throw Error(std::string("give either ") + flag +
+                    " or --max-error (which picks the volumetric steps, resolution, upsampling and noise sampling), "
+                    "not both");
+    if (runtime == nullptr)
+      throw Error("--max-error picks an OpenCL kernel variant; the scalar path (--device scalar) has none");
+    if (!(o.max_error >= 0.0))
+      throw Error("--max-error must be a number >= 0 (got " + str(o.max_error) + ")");
+  }
+
   s.volumes_ = read_volumes_json(o.volumes_path);
+  s.runtime_ = runtime;
   if (runtime != nullptr) s.pass_ = std::make_unique<VolumePass>(*runtime);
   return stage;
 }
@@ -560,11 +575,54 @@ VolumeScene VolumeStage::scene_for(int sequence_frame) const {
 void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
                         int sequence_frame, bool verbose) {
   const VolumeScene scene = scene_for(sequence_frame);
+  if (options_.max_error_given && (!chosen_ || chosen_storage_ != in.format())) {
+    // A missing measurement takes minutes (the 4096-step references, then every variant): say so.
+    VolumeBudgetOptions budget;
+    std::size_t last = 0;
+    budget.measure.progress = [&last](std::size_t done, std::size_t total) {
+      if (done == 0)
+        std::fprintf(stderr,
+                     "fogcl: --max-error: measuring %zu volumetric variants x scenes once for this device (the "
+                     "references first); the result is cached\n",
+                     total);
+      else if (10 * done / total != 10 * last / total)
+        std::fprintf(stderr, "  %zu/%zu\n", done, total);
+      last = done;
+    };
+    const VolumeQualityChoice c =
+        choose_volume_quality(*runtime_, settings_, in.format(), options_.max_error, budget);
+    settings_ = c.settings;
+    chosen_ = true;
+    chosen_storage_ = in.format();
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "volumetric error budget: --max-error %g, %s integrator, %s storage; measurement %s (%s)\n",
+                  options_.max_error, to_string(settings_.integrator), to_string(in.format()),
+                  c.from_cache ? "read from the cache" : "taken now and cached", c.measured_on.c_str());
+    budget_why_ = buf;
+    budget_why_ += "  cache: " + c.cache_file + "\n";
+    // Fastest first: every candidate before the chosen one is over the budget; show the last 10
+    // of them, the chosen one, and the next 3 (slower, for comparison).
+    std::size_t at = 0;
+    while (at < c.candidates.size() && !(c.candidates[at].max_abs_err <= options_.max_error)) ++at;
+    const std::size_t first = at > 10 ? at - 10 : 0;
+    if (first > 0) budget_why_ += "  (" + std::to_string(first) + " faster candidates over the budget not shown)\n";
+    for (std::size_t i = first; i < std::min(c.candidates.size(), at + 4); ++i) {
+      const VolumeVariantMeasurement& m = c.candidates[i];
+      std::snprintf(buf, sizeof buf, "  candidate %-30s worst color error %.3g, time %.3f ms over the scenes: %s\n",
+                    volume_quality_name(m.steps, m.divisor, m.upsampling, m.noise).c_str(), m.max_abs_err, m.time_ms,
+                    i == at ? "CHOSEN" : m.max_abs_err <= options_.max_error ? "meets the budget, slower"
+                                                                          : "over the budget");
+      budget_why_ += buf;
+    }
+    budget_why_ += "volumes: " + c.reason + "\n";
+  }
   if (pass_)
     pass_->apply(in, depth, out, camera, scene, settings_, shadow());
   else
     apply_volumes_scalar(in, depth, out, camera, scene, settings_, shadow());
   if (!verbose) return;
+  std::fprintf(stderr, "%s", budget_why_.c_str());
   const std::size_t visible = visible_volumes(scene, camera, max_eye_depth(depth, camera)).size();
   const int s = settings_.resolution_divisor;
   std::fprintf(

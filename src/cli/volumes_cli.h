@@ -33,6 +33,10 @@ struct VolumeCliOptions {
   std::string shadow_map_path, light_view_proj;
   bool shadow_reversed_z = false;
   std::vector<std::string> given;  // the volume flags on the command line
+  // --max-error E (fogcl apply's): picks steps, resolution, upsampling and noise sampling from the
+  // volumetric error budget (fogcl/volume_report.h); an error together with any of those flags.
+  bool max_error_given = false;
+  double max_error = 0;
 };
 
 // Registers the volume flags on `fogcl apply`.
@@ -73,7 +77,9 @@ class VolumeStage {
   const ShadowMap* shadow() const { return shadow_ ? &*shadow_ : nullptr; }
 
   // Composites the volumes onto `in` into `out` (the OpenCL pass, or the scalar path in float).
-  // verbose: prints the variant (integrator, steps, resolution, visible volumes, build options).
+  // verbose: prints the variant (integrator, steps, resolution, visible volumes, build options),
+  // and with --max-error the candidates and why one was chosen. With --max-error the first frame
+  // (and a frame of another storage) picks the variant for its storage.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
              int sequence_frame, bool verbose);
 
@@ -85,6 +91,10 @@ class VolumeStage {
   VolumeSettings settings_;
   std::optional<ShadowMap> shadow_;
   std::unique_ptr<VolumePass> pass_;  // null: scalar
+  const Runtime* runtime_ = nullptr;
+  bool chosen_ = false;                // --max-error: a variant was picked for chosen_storage_
+  ColorFormat chosen_storage_ = ColorFormat::rgba32f;
+  std::string budget_why_;             // --max-error: what --verbose prints
 };
 
 // `fogcl demo`'s volumetric rows (cli/demo_volumes.cpp): demo_fog_volumes() run on each

@@ -16,7 +16,7 @@
 
 #include "fogcl/error.h"
 #include "fogcl/report.h"
-#include "runtime/clhpp.h"
+#include "report/report_common.h"
 
 namespace fogcl {
 
@@ -26,39 +26,8 @@ namespace fs = std::filesystem;
 
 std::atomic<std::size_t> g_measurements{0};
 
-struct CacheKey {
-  std::string device, driver, version;
-};
-
-std::string default_cache_dir() {
-  const char* xdg = std::getenv("XDG_CACHE_HOME");
-  if (xdg != nullptr && *xdg == '/') return (fs::path(xdg) / "fogcl").string();
-  const char* home = std::getenv("HOME");
-  if (home != nullptr && *home != '\0') return (fs::path(home) / ".cache" / "fogcl").string();
-  return (fs::temp_directory_path() / "fogcl-cache").string();
-}
-
-std::string hex64(std::uint64_t v) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
-  return buf;
-}
-
-// FNV-1a 64 of the key: a stable file name per (device, driver, version).
-std::string cache_file_name(const CacheKey& k) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (const std::string* s : {&k.device, &k.driver, &k.version}) {
-    for (unsigned char c : *s) h = (h ^ c) * 1099511628211ull;
-    h = (h ^ 0xff) * 1099511628211ull;  // separator
-  }
-  return "error-budget-" + hex64(h) + ".csv";
-}
-
-std::string one_line(std::string s) {
-  std::replace(s.begin(), s.end(), '\n', ' ');
-  std::replace(s.begin(), s.end(), '\r', ' ');
-  return s;
-}
+using report_detail::one_line;
+using CacheKey = report_detail::DeviceKey;
 
 bool parse_precision(const std::string& s, Precision* p) {
   for (Precision q : {Precision::precise, Precision::fast})
@@ -127,14 +96,7 @@ void write_cache(const std::string& path, const CacheKey& key, const Cached& c) 
     std::snprintf(buf, sizeof buf, "%.17g,%.17g", m.max_abs_err_color, m.time_ms);
     s << to_string(m.precision) << ',' << to_string(m.storage) << ',' << buf << '\n';
   }
-  fs::create_directories(fs::path(path).parent_path());
-  const std::string tmp = path + ".tmp" + std::to_string(::getpid());
-  {
-    std::ofstream f(tmp, std::ios::trunc);
-    f << s.str();
-    if (!f.flush()) throw Error("cannot write the error-budget cache " + path);
-  }
-  fs::rename(tmp, path);  // atomic: a concurrent reader sees the old file or the new one
+  report_detail::write_cache_file(path, s.str());
 }
 
 Cached measure(const Runtime& runtime, const ReportOptions& options) {
@@ -162,11 +124,7 @@ Cached measure(const Runtime& runtime, const ReportOptions& options) {
   return c;
 }
 
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string num(double v) { return report_detail::short_num(v); }
 
 }  // namespace
 
@@ -176,16 +134,11 @@ PrecisionChoice choose_precision_detailed(const Runtime& runtime, ColorFormat st
                                           const BudgetOptions& options) {
   if (!(max_error >= 0.0))
     throw Error("max error must be a number >= 0 (got " + num(max_error) + ")");
-  const CacheKey key = with_cl_errors([&] {
-    const cl::Device d = wrap(runtime.device());
-    const cl::Platform platform(d.getInfo<CL_DEVICE_PLATFORM>());
-    return CacheKey{d.getInfo<CL_DEVICE_NAME>() + " (" + platform.getInfo<CL_PLATFORM_NAME>() + ")",
-                    d.getInfo<CL_DRIVER_VERSION>(), library_version()};
-  });
+  const CacheKey key = report_detail::device_key(runtime);
   PrecisionChoice choice;
   choice.max_error = max_error;
-  const std::string dir = options.cache_dir.empty() ? default_cache_dir() : options.cache_dir;
-  choice.cache_file = (fs::path(dir) / cache_file_name(key)).string();
+  const std::string dir = options.cache_dir.empty() ? report_detail::default_cache_dir() : options.cache_dir;
+  choice.cache_file = (fs::path(dir) / report_detail::cache_file_name("error-budget", key)).string();
 
   Cached cached;
   if (read_cache(choice.cache_file, key, &cached)) {

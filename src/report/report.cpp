@@ -13,9 +13,6 @@
 #include <memory>
 #include <sstream>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include "fogcl/camera.h"
 #include "fogcl/demo_scene.h"
 #include "fogcl/error.h"
@@ -23,9 +20,17 @@
 #include "fogcl/scalar.h"
 #include "pass/formulas.h"
 #include "runtime/clhpp.h"
+#include "report/report_common.h"
 #include "report_plot_py.h"  // generated from report/plot_report.py
 
 namespace fogcl {
+
+using report_detail::json_num;
+using report_detail::json_string;
+using report_detail::median;
+using report_detail::nonfinite_from_finite;
+using report_detail::num;
+using report_detail::write_file;
 
 // library_version(): src/runtime/version.cpp (fogcl/version.h).
 
@@ -89,58 +94,18 @@ double eye_depth_rel_err(const CameraParams& cam) {
   return worst;
 }
 
-// 8-bit sRGB code: NaN -> 0, clamp to [0, 1], IEC 61966-2-1 encode, round; no dither.
-int srgb8(double linear) {
-  const double l = std::isnan(linear) ? 0.0 : std::clamp(linear, 0.0, 1.0);
-  return int(std::lround(srgb_encode(l) * 255.0));
-}
-
-std::size_t nonfinite_from_finite(const ColorImage& out, const ColorImage& in) {
-  std::size_t n = 0;
-  for (int y = 0; y < in.height(); ++y)
-    for (int x = 0; x < in.width(); ++x) {
-      const glm::vec4 o = out.pixel(x, y), i = in.pixel(x, y);
-      for (int c = 0; c < 4; ++c) n += std::isfinite(i[c]) && !std::isfinite(o[c]);
-    }
-  return n;
-}
-
 // Fills the color error columns of `row` from the output of a run on `in`.
 void color_errors(const ColorImage& out, const ColorImage& in, const FogResult<double>& ref, ReportRow& row) {
-  std::vector<double> errs;
-  errs.reserve(3 * in.pixel_count());
-  std::size_t off = 0;
-  for (int y = 0; y < in.height(); ++y)
-    for (int x = 0; x < in.width(); ++x) {
-      const std::size_t i = std::size_t(y) * std::size_t(in.width()) + std::size_t(x);
-      const glm::vec4 g = out.pixel(x, y);
-      bool differs = false;
-      for (int c = 0; c < 3; ++c) {
-        const double r = ref.rgba[4 * i + std::size_t(c)];
-        const double e = std::fabs(double(g[c]) - r);
-        errs.push_back(std::isnan(e) ? std::numeric_limits<double>::infinity() : e);
-        row.max_ulp = std::max(row.max_ulp, errs.back() / ulp_of(r, row.storage));
-        differs = differs || srgb8(double(g[c])) != srgb8(r);
-      }
-      off += differs;
-    }
-  row.max_abs_err_color = *std::max_element(errs.begin(), errs.end());
-  const std::size_t k = std::min(errs.size() - 1, std::size_t(std::ceil(0.999 * double(errs.size()))) - 1);
-  std::nth_element(errs.begin(), errs.begin() + std::ptrdiff_t(k), errs.end());
-  row.p999_abs_err_color = errs[k];
-  row.pct_8bit_off = 100.0 * double(off) / double(in.pixel_count());
-  row.nonfinite += nonfinite_from_finite(out, in);
+  const report_detail::ColorErrorStats e = report_detail::color_error_stats(out, in, ref.rgba, row.storage);
+  row.max_abs_err_color = e.max_abs;
+  row.p999_abs_err_color = e.p999_abs;
+  row.max_ulp = e.max_ulp;
+  row.pct_8bit_off = e.pct_8bit_off;
+  row.nonfinite += e.nonfinite;
 }
 
 ColorImage white_like(const ColorImage& like) {
   return uniform_image(like.width(), like.height(), like.format(), glm::vec4(1.0f));
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // The pass on the runtime's queue, zero-copy buffers over the images' memory on CPU devices
@@ -196,40 +161,6 @@ double scalar_run(const ColorImage& in, const DepthImage& depth, ColorImage& out
 
 std::string variant_name(bool scalar, Precision p, ColorFormat storage) {
   return std::string(scalar ? "scalar" : to_string(p)) + "-" + to_string(storage);
-}
-
-// Numbers as text: shortest round-trip-ish (%.6g), "inf"/"nan" spelled for CSV; JSON gets null.
-std::string num(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-std::string json_num(double v) { return std::isfinite(v) ? num(v) : "null"; }
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else out += c;
-  }
-  return out + "\"";
-}
-
-void write_file(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    if (!f) throw Error("cannot write " + path);
-    f << text;
-    if (!f.flush()) throw Error("cannot write " + path);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error("cannot write " + path);
 }
 
 }  // namespace
@@ -334,23 +265,7 @@ void write_report_json(const Report& r, const std::string& path) {
 }
 
 void plot_report(const std::string& dir, const std::string& python) {
-  const std::string install = "install python3-matplotlib (apt-get install python3-matplotlib, or scripts/setup.sh --bench)";
-  if (::access(python.c_str(), X_OK) != 0)
-    throw Error("cannot draw report.png: " + python + " is missing; " + install);
-  // The script reads the folder from argv[1]; exit code 3 means "matplotlib missing".
-  std::string quoted = "'";
-  for (char c : dir) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  quoted += "'";
-  const std::string cmd = python + " - " + quoted;
-  FILE* p = ::popen(cmd.c_str(), "w");
-  if (p == nullptr) throw Error("cannot draw report.png: cannot run " + python);
-  const std::size_t n = sizeof(report_plot_py) - 1;
-  const bool sent = std::fwrite(report_plot_py, 1, n, p) == n;
-  const int status = ::pclose(p);
-  const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  if (code == 3) throw Error("cannot draw report.png: matplotlib is missing for " + python + "; " + install);
-  if (!sent || code != 0)
-    throw Error("cannot draw report.png: the plotting script failed (" + python + " exit code " + std::to_string(code) + ")");
+  report_detail::run_plot_script(dir, python, report_plot_py, sizeof(report_plot_py) - 1, "report.png");
 }
 
 }  // namespace fogcl

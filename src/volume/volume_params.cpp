@@ -136,7 +136,14 @@ void validate(const VolumeScene& s) {
   if (!std::isfinite(s.time)) throw Error("time must be finite (got " + str(s.time) + ")");
 }
 
-const char* to_string(VolumeIntegrator i) { return i == VolumeIntegrator::stylized ? "stylized" : "physical"; }
+const char* to_string(VolumeIntegrator i) {
+  switch (i) {
+    case VolumeIntegrator::stylized: return "stylized";
+    case VolumeIntegrator::physical: return "physical";
+    case VolumeIntegrator::riemann: return "riemann";
+  }
+  return "unknown";
+}
 const char* to_string(VolumeUpsampling u) { return u == VolumeUpsampling::depth_aware ? "depth-aware" : "bilinear"; }
 const char* to_string(NoiseSampling s) { return s == NoiseSampling::buffer ? "buffer" : "image"; }
 
@@ -311,9 +318,18 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   return out;
 }
 
+int integrator_code(VolumeIntegrator integrator) {
+  switch (integrator) {
+    case VolumeIntegrator::stylized: return VOL_STYLIZED;
+    case VolumeIntegrator::physical: return VOL_PHYSICAL;
+    case VolumeIntegrator::riemann: return VOL_RIEMANN;
+  }
+  throw Error("volume integrator " + std::to_string(int(integrator)) + " is not one of stylized, physical, riemann");
+}
+
 std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& device) {
   std::string o = cl_std_option(device);
-  o += " -D VOL_INTEGRATOR=" + std::to_string(v.integrator == VolumeIntegrator::stylized ? VOL_STYLIZED : VOL_PHYSICAL);
+  o += " -D VOL_INTEGRATOR=" + std::to_string(integrator_code(v.integrator));
   o += " -D VOL_STEPS=" + std::to_string(v.steps);
   o += " -D VOL_FEATURES=" + std::to_string(v.features);
   o += " -D VOL_JITTER=" + std::to_string(v.jitter ? 1 : 0);

@@ -46,6 +46,9 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
                                     const ShadowMapParams* shadow, int shadow_width, int shadow_height,
                                     float max_eye_depth);
 
+// VOL_STYLIZED, VOL_PHYSICAL or VOL_RIEMANN (kernels/volume_common.h): the march's integrator switch.
+int integrator_code(VolumeIntegrator integrator);
+
 std::string volume_march_options(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_composite_options(const VolumeVariant& variant, const DeviceTraits& device);
 

@@ -40,7 +40,7 @@ VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, co
                                   : nullptr;
   const int projection = int(v.projection), reversed = v.reversed_z;
   const float* shadow_map = shadow ? shadow->depth.data() : nullptr;
-  const int integrator = v.integrator == VolumeIntegrator::stylized ? VOL_STYLIZED : VOL_PHYSICAL;
+  const int integrator = detail::integrator_code(v.integrator);
   r.low_width = f.low_width;
   r.low_height = f.low_height;
   r.low.resize(4 * std::size_t(f.low_width) * f.low_height);

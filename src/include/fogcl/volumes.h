@@ -85,6 +85,10 @@ struct ShadowMap {
 enum class VolumeIntegrator {
   stylized,  // the seed's accumulator, for visual parity with it
   physical,  // energy-conserving (Hillaire 2015), exact for piecewise-constant extinction
+  // The physical model with the textbook left Riemann sum per segment (I += T * sigma_s * L * d):
+  // for comparison only (fogcl report --volumetric), it overshoots by up to sigma_t * d in dense
+  // media. Never picked by fogcl; no CLI flag selects it.
+  riemann,
 };
 
 enum class VolumeUpsampling {

@@ -1,0 +1,341 @@
+// Error against run time of the volumetric pass (fogcl report --volumetric), the volumetric error
+// budget (--max-error with --volumes) and its cache, on small frames and few variants so the
+// whole file runs in seconds.
+#include "fogcl/volume_report.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include "fogcl/demo_scene.h"
+#include "fogcl/exr_io.h"
+#include "fogcl/volume_pass.h"
+#include "test_support.h"
+
+namespace fogcl::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string fresh_dir(const std::string& name) {
+  const std::string d = temp_dir() + "/" + name + "-" + std::to_string(::getpid());
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::vector<std::vector<std::string>> read_csv(const std::string& path) {
+  std::ifstream f(path);
+  std::vector<std::vector<std::string>> rows;
+  std::string line;
+  while (std::getline(f, line)) {
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream s(line);
+    while (std::getline(s, cell, ',')) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// Few variants: 2 step counts x (full, half depth-aware, half bilinear) x 2 integrators, buffer
+// noise, rgba32f, plus the Riemann rows on the dense scene.
+VolumeReportOptions small_report() {
+  VolumeReportOptions o;
+  o.width = 32;
+  o.height = 18;
+  o.runs = 3;
+  o.steps = {8, 64};
+  o.divisors = {1, 2};
+  o.noise = {NoiseSampling::buffer};
+  o.storages = {ColorFormat::rgba32f};
+  return o;
+}
+
+const VolumeReportRow* find(const VolumeReport& r, const std::string& scene, VolumeIntegrator integrator, int steps,
+                            int divisor) {
+  for (const VolumeReportRow& row : r.rows)
+    if (row.scene == scene && row.integrator == integrator && row.steps == steps && row.divisor == divisor &&
+        row.upsampling == VolumeUpsampling::depth_aware)
+      return &row;
+  return nullptr;
+}
+
+// ctest runs each test in a process of its own: each runs only the rows it checks.
+TEST(VolumeReport, RowsAreSaneAndFilesAreWritten) {
+  FOGCL_REQUIRE_DEVICE();
+  const VolumeReport r = run_volume_report(*runtime(), small_report());
+  // 4 scenes x 2 integrators x 2 steps x 3 resolutions/upsamplings + 2 Riemann rows.
+  ASSERT_EQ(r.rows.size(), 4u * 2 * 2 * 3 + 2);
+  EXPECT_EQ(r.reference_steps, 4096);
+  for (const VolumeReportRow& row : r.rows) {
+    std::printf("[ vreport ] %-7s %-44s %8.3f ms  max %.3g  p999 %.3g  8bit %.3g%%  nonfinite %zu\n", row.scene.c_str(),
+                row.variant.c_str(), row.time_ms, row.max_abs_err, row.p999_abs_err, row.pct_8bit_off, row.nonfinite);
+    EXPECT_GT(row.time_ms, 0.0) << row.variant;
+    EXPECT_EQ(row.nonfinite, 0u) << row.scene << " " << row.variant;
+    EXPECT_TRUE(std::isfinite(row.max_abs_err)) << row.scene << " " << row.variant;
+    EXPECT_LE(row.p999_abs_err, row.max_abs_err) << row.scene << " " << row.variant;
+    EXPECT_GE(row.pct_8bit_off, 0.0);
+    EXPECT_LE(row.pct_8bit_off, 100.0);
+    // Thin media keep their digits: sigma_t * diameter = 1e-4 changes colors by ~1e-5 at most.
+    if (row.scene == "thin") {
+      EXPECT_LE(row.max_abs_err, 1e-5) << row.variant;
+    }
+  }
+
+  const std::string dir = fresh_dir("volume-report");
+  write_volume_report_csv(r, dir + "/volume-report.csv");
+  write_volume_report_json(r, dir + "/volume-report.json");
+  const auto csv = read_csv(dir + "/volume-report.csv");
+  ASSERT_EQ(csv.size(), r.rows.size() + 1);
+  std::map<std::string, std::size_t> col;
+  for (std::size_t i = 0; i < csv[0].size(); ++i) col[csv[0][i]] = i;
+  for (const char* name : {"scene", "variant", "integrator", "steps", "resolution", "upsampling", "noise", "storage",
+                           "time_ms", "max_abs_err", "p999_abs_err", "pct_8bit_off", "nonfinite"})
+    ASSERT_TRUE(col.count(name)) << "column " << name;
+  for (std::size_t i = 1; i < csv.size(); ++i) {
+    ASSERT_EQ(csv[i].size(), csv[0].size()) << "row " << i;
+    EXPECT_EQ(csv[i][col["variant"]], r.rows[i - 1].variant);
+    EXPECT_EQ(std::stoi(csv[i][col["steps"]]), r.rows[i - 1].steps);
+    for (const char* numeric : {"time_ms", "max_abs_err", "p999_abs_err", "pct_8bit_off", "nonfinite"}) {
+      const std::string& text = csv[i][col[numeric]];
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      EXPECT_TRUE(!text.empty() && *end == '\0') << numeric << " '" << text << "'";
+      EXPECT_TRUE(std::isfinite(v) && v >= 0) << numeric << " " << v;
+    }
+  }
+  std::ifstream json(dir + "/volume-report.json");
+  const std::string js((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  EXPECT_NE(js.find("\"reference_steps\": 4096"), std::string::npos) << js.substr(0, 400);
+  EXPECT_NE(js.find("\"variant\": \"riemann-s8-full-buffer-rgba32f\""), std::string::npos);
+  EXPECT_EQ(std::count(js.begin(), js.end(), '{'), std::ptrdiff_t(r.rows.size() + 1));
+
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "/usr/bin/python3 has no matplotlib (apt-get install python3-matplotlib)";
+  plot_volume_report(dir);
+  ASSERT_TRUE(fs::exists(dir + "/volume-report.png"));
+  EXPECT_GT(fs::file_size(dir + "/volume-report.png"), 10000u);
+}
+
+TEST(VolumeReport, PhysicalErrorShrinksWithStepsOnTheDemo) {
+  FOGCL_REQUIRE_DEVICE();
+  VolumeReportOptions o = small_report();
+  o.scenes = {"demo"};
+  o.divisors = {1};
+  const VolumeReport r = run_volume_report(*runtime(), o);
+  // Full resolution: no upsampling error, the march's own. (The stylized march's adaptive
+  // stepping moves its samples discontinuously with the step count: not monotone, printed only.)
+  for (VolumeIntegrator i : {VolumeIntegrator::physical, VolumeIntegrator::stylized}) {
+    const VolumeReportRow* coarse = find(r, "demo", i, 8, 1);
+    const VolumeReportRow* fine = find(r, "demo", i, 64, 1);
+    ASSERT_TRUE(coarse && fine);
+    std::printf("  demo, %s, full resolution: max error %.3g (8 steps) -> %.3g (64 steps)\n", to_string(i),
+                coarse->max_abs_err, fine->max_abs_err);
+    if (i == VolumeIntegrator::physical) {
+      EXPECT_LT(fine->max_abs_err, 0.5 * coarse->max_abs_err);
+      EXPECT_LT(fine->p999_abs_err, 0.5 * coarse->p999_abs_err);
+    }
+  }
+}
+
+TEST(VolumeReport, PhysicalIsFarBelowTheRiemannSumOnTheDenseScene) {
+  FOGCL_REQUIRE_DEVICE();
+  VolumeReportOptions o = small_report();
+  o.scenes = {"dense"};
+  o.divisors = {1};
+  o.integrators = {VolumeIntegrator::physical};
+  const VolumeReport r = run_volume_report(*runtime(), o);
+  ASSERT_EQ(r.rows.size(), 2u * 2) << "physical and riemann at 8 and 64 steps";
+  for (int steps : {8, 64}) {
+    const VolumeReportRow* physical = find(r, "dense", VolumeIntegrator::physical, steps, 1);
+    const VolumeReportRow* riemann = find(r, "dense", VolumeIntegrator::riemann, steps, 1);
+    ASSERT_TRUE(physical && riemann) << steps;
+    std::printf("  dense, %d steps: physical %.3g, riemann %.3g\n", steps, physical->max_abs_err, riemann->max_abs_err);
+    // Constant extinction: the exact segment weight leaves float rounding only.
+    EXPECT_LE(physical->max_abs_err, 1e-4);
+    EXPECT_GT(riemann->max_abs_err, 1000.0 * physical->max_abs_err);
+  }
+  EXPECT_LT(find(r, "dense", VolumeIntegrator::riemann, 64, 1)->max_abs_err,
+            find(r, "dense", VolumeIntegrator::riemann, 8, 1)->max_abs_err)
+      << "the Riemann sum converges, slowly";
+}
+
+TEST(VolumeReportOptionsCheck, BadOptionsNameTheValueAndTheRule) {
+  FOGCL_REQUIRE_DEVICE();
+  const struct {
+    std::function<void(VolumeReportOptions&)> change;
+    std::string expect;
+  } cases[] = {
+      {[](VolumeReportOptions& o) { o.runs = 2; }, "runs must be >= 3 for a median (got 2)"},
+      {[](VolumeReportOptions& o) { o.steps = {0}; }, "steps must be in [1, 4096] (got 0)"},
+      {[](VolumeReportOptions& o) { o.divisors = {3}; }, "divisor must be 1, 2 or 4 (got 3)"},
+      {[](VolumeReportOptions& o) { o.scenes = {"fog"}; }, "scene 'fog' is not one of"},
+      {[](VolumeReportOptions& o) { o.width = 0; }, "frame size must be >= 1x1 (got 0x90)"},
+  };
+  for (const auto& c : cases) {
+    VolumeReportOptions o;
+    c.change(o);
+    try {
+      run_volume_report(*runtime(), o);
+      ADD_FAILURE() << "accepted: " << c.expect;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << e.what();
+    }
+  }
+}
+
+// The budget's measurement: small frames, two step counts, full and half resolution.
+VolumeBudgetOptions small_budget(const std::string& cache_dir) {
+  VolumeBudgetOptions o;
+  o.cache_dir = cache_dir;
+  o.measure.width = 24;
+  o.measure.height = 14;
+  o.measure.runs = 3;
+  o.measure.steps = {8, 64};  // the report test's: PoCL's program cache serves both
+  o.measure.divisors = {1, 2};
+  o.measure.noise = {NoiseSampling::buffer};
+  o.measure.reference_steps = 1024;
+  return o;
+}
+
+TEST(VolumeErrorBudget, PicksTheFastestMeetingTheBudgetAndReadsItsCache) {
+  FOGCL_REQUIRE_DEVICE();
+  const VolumeBudgetOptions o = small_budget(fresh_dir("volume-budget"));
+  VolumeSettings base;
+  base.integrator = VolumeIntegrator::physical;
+  const std::size_t before = volume_budget_measurements();
+
+  const VolumeQualityChoice first = choose_volume_quality(*runtime(), base, ColorFormat::rgba32f, 1e9, o);
+  EXPECT_FALSE(first.from_cache);
+  EXPECT_EQ(volume_budget_measurements(), before + 1);
+  ASSERT_TRUE(fs::exists(first.cache_file)) << first.cache_file;
+  ASSERT_EQ(first.candidates.size(), 2u * 3) << "2 steps x (full, half depth-aware, half bilinear)";
+  for (const VolumeVariantMeasurement& m : first.candidates)
+    std::printf("[ vbudget  ] %-28s worst error %.3g, %.3f ms\n",
+                volume_quality_name(m.steps, m.divisor, m.upsampling, m.noise).c_str(), m.max_abs_err, m.time_ms);
+  for (std::size_t i = 1; i < first.candidates.size(); ++i)
+    EXPECT_LE(first.candidates[i - 1].time_ms, first.candidates[i].time_ms) << "fastest first";
+  EXPECT_EQ(first.chosen.time_ms, first.candidates[0].time_ms) << "a huge budget picks the fastest";
+  EXPECT_EQ(first.settings.integrator, VolumeIntegrator::physical) << "the integrator is the caller's";
+  EXPECT_FALSE(first.reason.empty());
+
+  // A budget between the most and the least accurate: the fastest variant meeting it, read from
+  // the cache this time.
+  double lo = INFINITY, hi = 0;
+  for (const VolumeVariantMeasurement& m : first.candidates)
+    lo = std::min(lo, m.max_abs_err), hi = std::max(hi, m.max_abs_err);
+  ASSERT_LT(lo, hi);
+  const double budget = std::sqrt(lo * hi);
+  const VolumeQualityChoice second = choose_volume_quality(*runtime(), base, ColorFormat::rgba32f, budget, o);
+  EXPECT_TRUE(second.from_cache);
+  EXPECT_EQ(volume_budget_measurements(), before + 1) << "the second call reads the cache";
+  std::printf("[ vbudget  ] budget %.3g: %s\n", budget, second.reason.c_str());
+  EXPECT_LE(second.chosen.max_abs_err, budget);
+  for (const VolumeVariantMeasurement& m : second.candidates)
+    if (m.time_ms < second.chosen.time_ms) {
+      EXPECT_GT(m.max_abs_err, budget) << "a faster variant met the budget";
+    }
+  EXPECT_EQ(second.settings.steps, second.chosen.steps);
+  EXPECT_EQ(second.settings.resolution_divisor, second.chosen.divisor);
+  EXPECT_EQ(second.settings.upsampling, second.chosen.upsampling);
+
+  // Below every variant: a clear error naming the budget and the best achievable error.
+  try {
+    choose_volume_quality(*runtime(), base, ColorFormat::rgba32f, 1e-12, o);
+    ADD_FAILURE() << "a 1e-12 budget was met";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    std::printf("[ message  ] %s\n", m.c_str());
+    EXPECT_NE(m.find("max error 1e-12"), std::string::npos) << m;
+    EXPECT_NE(m.find("best achievable"), std::string::npos) << m;
+  }
+  EXPECT_THROW(choose_volume_quality(*runtime(), base, ColorFormat::rgba32f, -1.0, o), Error);
+  EXPECT_EQ(volume_budget_measurements(), before + 1);
+}
+
+// fogcl apply --volumes --max-error: reads the cache the API wrote, prints the choice, runs it.
+TEST(VolumeErrorBudgetCli, MaxErrorPicksTheVariantAndExplicitFlagsConflict) {
+  FOGCL_REQUIRE_DEVICE();
+  const std::string dir = fresh_dir("volume-budget-cli");
+  const DemoFrame frame = render_demo_scene(48, 27);
+  write_exr_rgba(dir + "/scene.exr", frame.color);
+  write_exr_depth(dir + "/scene-depth.exr", frame.depth);
+  std::ofstream(dir + "/volumes.json") << R"({"volumes": [{"center": [0.5, 1.5, 4], "radius": 2.5, "density": 0.6,
+      "fade_edge": 1, "proximity_fade": 0.5, "tiling": [0.2, 0.2, 0.2], "detail_tiling": [0.6, 0.6, 0.6]}]})";
+  const ColorFormat storage = read_exr_color(dir + "/scene.exr").format();
+  VolumeSettings base;  // stylized, as the CLI's default
+  const VolumeQualityChoice measured =
+      choose_volume_quality(*runtime(), base, storage, 1e9, small_budget(dir + "/xdg/fogcl"));
+  const DemoView view;
+  const glm::vec3 fwd = view.target - view.eye;
+  char pose[256];
+  std::snprintf(pose, sizeof pose, " --eye %.9g,%.9g,%.9g --forward %.9g,%.9g,%.9g --up 0,1,0", view.eye.x, view.eye.y,
+                view.eye.z, fwd.x, fwd.y, fwd.z);
+  const std::string common = "apply --color " + dir + "/scene.exr --depth " + dir +
+                             "/scene-depth.exr --near 0.3 --far 1000 --fov 60 --volumes " + dir + "/volumes.json" +
+                             pose + " --device " + cli_device();
+  const std::string env = "XDG_CACHE_HOME='" + dir + "/xdg'";
+
+  const CliRun r = run_cli(common + " --verbose --max-error 1e9 --out " + dir + "/out.exr", env);
+  std::printf("%s", r.output.c_str());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("measurement read from the cache"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("CHOSEN"), std::string::npos) << r.output;
+  const std::string chosen = volume_quality_name(measured.chosen.steps, measured.chosen.divisor,
+                                                 measured.chosen.upsampling, measured.chosen.noise);
+  EXPECT_NE(r.output.find("volumes: " + chosen + " is the fastest variant"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("precision: not chosen (--mode off"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(std::to_string(measured.chosen.steps) + " steps"), std::string::npos) << r.output;
+
+  // The explicit flags the budget picks are a contradiction with it: exit 1, one line, no file.
+  for (const std::string flag :
+       {"--steps 32", "--volume-resolution full", "--upsample bilinear", "--noise-sampling buffer"}) {
+    const CliRun bad = run_cli(common + " --max-error 1 " + flag + " --out " + dir + "/bad.exr", env);
+    std::printf("[ message  ] %s", bad.output.c_str());
+    EXPECT_EQ(bad.exit_code, 1) << flag << ": " << bad.output;
+    EXPECT_NE(bad.output.find("give either " + flag.substr(0, flag.find(' ')) + " or --max-error"), std::string::npos)
+        << bad.output;
+    EXPECT_FALSE(fs::exists(dir + "/bad.exr"));
+  }
+  const CliRun tiny = run_cli(common + " --max-error 1e-12 --out " + dir + "/tiny.exr", env);
+  EXPECT_EQ(tiny.exit_code, 1) << tiny.output;
+  EXPECT_NE(tiny.output.find("no volumetric variant meets the error budget (max error 1e-12)"), std::string::npos)
+      << tiny.output;
+  EXPECT_FALSE(fs::exists(dir + "/tiny.exr"));
+}
+
+// fogcl report's volumetric flags: bad values and misplaced flags are one line, exit 1, before
+// any measurement.
+TEST(VolumeReportCli, BadFlagsAreOneLineErrors) {
+  const std::string out = fresh_dir("volume-report-cli");
+  const struct {
+    std::string args, expect;
+  } cases[] = {
+      {"--volumetric --device scalar", "the scalar path (--device scalar) has none"},
+      {"--volumetric --integrators riemann", "--integrators: 'riemann' is not one of stylized, physical"},
+      {"--volumetric --runs 2 --device " + cli_device(), "runs must be >= 3 for a median (got 2)"},
+      {"--volumetric --scenes fog --device " + cli_device(), "scene 'fog' is not one of demo, dense, thin, inside"},
+      {"--steps 8", "--steps selects volumetric variants; it needs --volumetric"},
+      {"--runs 5", "--runs must be >= 7 for the deferred report (got 5)"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli("report --out " + out + " " + c.args);
+    std::printf("[ message  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << ": " << r.output;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << c.args << ": " << r.output;
+    EXPECT_FALSE(fs::exists(out + "/volume-report.csv")) << c.args;
+  }
+}
+
+}  // namespace
+}  // namespace fogcl::test
