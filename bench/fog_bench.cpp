@@ -6,6 +6,8 @@
 //   BM_Scalar            fogcl's scalar C++ path (one thread, as built for users)
 //   BM_OpenMPSimd        the OpenMP + SIMD C++ peer (-O3 -march=native, 2 threads)
 //   BM_OpenMPSimdFastMath  the same with -ffast-math (vectorised exp2; no NaN/Inf guarantees)
+//   BM_Halide            the Halide 14 peer (JIT for the host, 2 threads; built when Halide is
+//                        found): one whole realize() per iteration, compiled before the loop
 //   BM_OpenCLDevice      the OpenCL pass, zero-copy buffers, device time from profiling events
 //   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish); on a
 //                        GPU the host round trip: upload + kernel + download
@@ -41,7 +43,11 @@
 #include "fogcl/demo_scene.h"
 #include "fogcl/fogcl.h"
 #include "runtime/clhpp.h"
+#include "runtime/frame_buffers.h"
 #include "openmp_peer.h"
+#ifdef FOGCL_HAVE_HALIDE
+#include "halide_peer.h"
+#endif
 
 namespace {
 
@@ -236,6 +242,16 @@ void BM_OpenMPSimdFastMath(benchmark::State& state) {
   });
 }
 
+#ifdef FOGCL_HAVE_HALIDE
+void BM_Halide(benchmark::State& state) {
+  const Case c = case_of(state);
+  bench::halide_prepare(frame(c.w, c.h, c.format).params, c.settings, c.format, kThreads);  // JIT, not timed
+  timed_fog(state, "halide", [](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    return host_time([&] { bench::halide_fog(f.color, f.depth, out, f.params, s, kThreads); });
+  });
+}
+#endif
+
 Runtime* runtime(benchmark::State& state) {
   static std::unique_ptr<Runtime> rt;
   static std::string error;
@@ -337,6 +353,72 @@ void BM_OpenCLHostCall(benchmark::State& state) {
   timed_fog(state, "opencl-host", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     return host_time([&] { pass.apply(f.color, f.depth, out, f.params, s); });
   });
+}
+
+// Where a convenience call's time goes: FogPass::apply's steps on a CPU device as it ran them
+// before host-call caching (a USE_HOST_PTR buffer per image, created and released per call; the
+// blocking map, unmap and finish of the read-back), one by one, each timed on the host:
+//   create_us    three clCreateBuffer(CL_MEM_USE_HOST_PTR) on the images
+//   check_us     the integration API's checks (queue and buffer getInfo: context, device, sizes)
+//   enqueue_us   FogPass::enqueue (the same checks, 13 setArg, clEnqueueNDRangeKernel)
+//   wait_us      enqueue returned -> the kernel's event complete (clWaitForEvents)
+//   device_us    the kernel's profiling START -> END
+//   launch_us    its profiling QUEUED -> START (PoCL's scheduler and thread wake-up)
+//   readback_us  the blocking map, the unmap and clFinish after the kernel completed
+//   release_us   the three buffers released
+// The time is the call's (all but check_us, which enqueue_us contains); parts_vs_device = that /
+// device time.
+void BM_HostCallParts(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  if (!rt->is_cpu()) return state.SkipWithError("host-call parts are measured on CPU devices");
+  FogPass& pass = shared_pass(*rt);
+  const Case c = case_of(state);
+  const DemoFrame& f = frame(c.w, c.h, c.format);
+  ColorImage out(f.color.width(), f.color.height(), f.color.format());
+  pass.prepare(c.settings, f.params, c.format);
+  pass.apply(f.color, f.depth, out, f.params, c.settings);  // first touch of `out`
+  const cl::Context ctx = wrap(rt->context());
+  const cl::CommandQueue queue = wrap(rt->queue());
+  const cl::Device device = wrap(rt->device());
+  double create = 0, check = 0, enq = 0, wait = 0, dev = 0, launch = 0, read = 0, release = 0;
+  for (auto _ : state) {
+    const auto begin = Clock::now();
+    auto a = begin;
+    auto hf = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+    create += seconds_since(a);
+    a = Clock::now();
+    detail::checked_queue(queue(), ctx, device, "parts");
+    detail::check_frame_buffers(hf->raw, ctx);
+    const double check_seconds = seconds_since(a);
+    check += check_seconds;
+    a = Clock::now();
+    const cl::Event done = adopt(pass.enqueue(queue(), hf->raw, f.params, c.settings));
+    enq += seconds_since(a);
+    a = Clock::now();
+    done.wait();
+    wait += seconds_since(a);
+    const auto queued = done.getProfilingInfo<CL_PROFILING_COMMAND_QUEUED>();
+    const auto start = done.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+    dev += double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - start) * 1e-9;
+    launch += double(start - queued) * 1e-9;
+    a = Clock::now();
+    void* mapped = queue.enqueueMapBuffer(hf->color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes());
+    queue.enqueueUnmapMemObject(hf->color_out, mapped);
+    queue.finish();
+    read += seconds_since(a);
+    a = Clock::now();
+    hf.reset();
+    release += seconds_since(a);
+    state.SetIterationTime(seconds_since(begin) - check_seconds);  // the call's time: the parts but the extra check
+  }
+  const double n = double(state.iterations());
+  const double total = create + enq + wait + read + release;
+  for (auto [name, v] : {std::pair{"create_us", create}, {"check_us", check}, {"enqueue_us", enq}, {"wait_us", wait},
+                         {"device_us", dev}, {"launch_us", launch}, {"readback_us", read}, {"release_us", release}})
+    state.counters[name] = v / n * 1e6;
+  state.counters["parts_vs_device"] = total / dev;
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(pass_bytes(f)));
 }
 
 // Optical depth density * d across the frame ~ 10^range(0) at the demo scene's distances: 1 (f in
@@ -481,9 +563,19 @@ BENCHMARK(BM_Memcpy)->Apply(MemcpyArgs);
 BENCHMARK(BM_Scalar)->Apply(FogArgs);
 BENCHMARK(BM_OpenMPSimd)->Apply(FogArgs);
 BENCHMARK(BM_OpenMPSimdFastMath)->Apply(FogArgs);
+#ifdef FOGCL_HAVE_HALIDE
+BENCHMARK(BM_Halide)->Apply(FogArgs);
+#endif
 BENCHMARK(BM_OpenCLDevice)->Apply(DeviceArgs);
 BENCHMARK(BM_OpenCLDevice)->Name("BM_OpenCLDeviceCacheResident")->Apply(CacheResidentArgs);
 BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
+BENCHMARK(BM_HostCallParts)
+    ->ArgNames({"w", "h", "mode", "dist", "f16"})
+    ->ArgsProduct({{1920}, {1080}, {0, 2}, {0}, {0, 1}})
+    ->ArgsProduct({{3840}, {2160}, {0, 2}, {0}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2);
 BENCHMARK(BM_DeviceCopy)
     ->ArgNames({"w", "h", "f16"})
     ->ArgsProduct({{1920}, {1080}, {0, 1}})

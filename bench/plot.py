@@ -21,6 +21,7 @@ PATHS = {
     "BM_Scalar": "scalar C++ (1 thread)",
     "BM_OpenMPSimd": "OpenMP+SIMD C++ (2 threads)",
     "BM_OpenMPSimdFastMath": "OpenMP+SIMD -ffast-math (2 threads)",
+    "BM_Halide": "Halide 14 JIT (2 threads)",
     "BM_OpenCLDevice": "OpenCL PoCL, device time",
     "BM_OpenCLHostCall": "OpenCL PoCL, host call",
 }
@@ -82,8 +83,13 @@ fig.tight_layout()
 fig.savefig(out / "throughput.png", dpi=110)
 
 # Table: per resolution / mode / metric / storage: ms and ratio to memcpy2 for each path.
-lines = ["| frame | fog | storage | memcpy 2T ms (interleaved) | scalar ms | OpenMP ms | OpenMP fast-math ms | OpenCL device ms | OpenCL device, streaming stores ms | OpenCL host call ms | OpenCL / memcpy2 | OpenCL vs scalar | max err (OpenCL) |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+# The Halide peer's own error sits next to its time; host call / device and host call / Halide are
+# the ratios of the host-call targets (the same run).
+lines = ["| frame | fog | storage | memcpy 2T ms (interleaved) | scalar ms | OpenMP ms | OpenMP fast-math ms | Halide ms | "
+         "OpenCL device ms | OpenCL device, streaming stores ms | OpenCL host call ms | host call / device | "
+         "host call / Halide | OpenCL / memcpy2 | host call / memcpy2 | Halide / memcpy2 | OpenCL vs scalar | "
+         "max err (OpenCL) | max err (Halide) |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 by_case = defaultdict(dict)
 for _, (n, a, b) in rows.items():
     if "mode" in a:
@@ -98,11 +104,19 @@ for (w, h, mode, dist, f16), paths in sorted(by_case.items(), key=lambda kv: (kv
     ratio = f"{cl['vs_memcpy2']:.2f}" if cl else "-"
     speedup = f"{ms(sc) / ms(cl):.1f}x" if cl and sc else "-"
     err = f"{cl['max_err']:.1e}" if cl else "-"
+    hc = paths.get("BM_OpenCLHostCall")
+    hl = paths.get("BM_Halide")
+    hc_dev = f"{ms(hc) / ms(cl):.2f}" if hc and cl else "-"
+    hc_hl = f"{ms(hc) / ms(hl):.2f}" if hc and hl else "-"
+    hc_m2 = f"{hc['vs_memcpy2']:.2f}" if hc else "-"
+    hl_m2 = f"{hl['vs_memcpy2']:.2f}" if hl else "-"
+    hl_err = f"{hl['max_err']:.1e}" if hl else "-"
     # The ceiling the ratio used: the 2-thread memcpy measured interleaved with the OpenCL rows.
     m2 = f"{cl['memcpy2_ms']:.2f}" if cl and "memcpy2_ms" in cl else "-"
     lines.append(f"| {w}x{h} | {MODES[mode]} {'distance' if dist == '1' else 'depth'} | {'f16' if f16 == '1' else 'f32'} | "
-                 f"{m2} | {t('BM_Scalar')} | {t('BM_OpenMPSimd')} | {t('BM_OpenMPSimdFastMath')} | {t('BM_OpenCLDevice')} | "
-                 f"{t('BM_OpenCLDevice-nt')} | {t('BM_OpenCLHostCall')} | {ratio} | {speedup} | {err} |")
+                 f"{m2} | {t('BM_Scalar')} | {t('BM_OpenMPSimd')} | {t('BM_OpenMPSimdFastMath')} | {t('BM_Halide')} | "
+                 f"{t('BM_OpenCLDevice')} | {t('BM_OpenCLDevice-nt')} | {t('BM_OpenCLHostCall')} | {hc_dev} | {hc_hl} | "
+                 f"{ratio} | {hc_m2} | {hl_m2} | {speedup} | {err} | {hl_err} |")
 
 extra = []
 for _, (n, a, b) in rows.items():
@@ -135,6 +149,16 @@ for (w, h, t), b in sorted(memcpy.items()):
     if (w, h) == (512, 256):
         cache.append(f"| memcpy of the RGBA32F frame's bytes, {t} thread{'s' if t > 1 else ''} | | {ms(b) * 1e3:.1f} | "
                      f"{ms(b) * 1e6 * 16 / (w * h):.2f} | |")
-(out / "table.md").write_text("\n".join(lines) + "\n\n" + "\n".join(cache) +
+# Where the host call's time goes (BM_HostCallParts: apply's steps before buffer caching, timed apart).
+parts = ["| host call parts, µs | storage | create buffers | checks | enqueue | wait | device | queued -> start | "
+         "map + unmap + finish | release | call ms | call / device |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+for name, (n, a, b) in sorted(((k, v) for k, v in rows.items() if v[0] == "BM_HostCallParts"),
+                              key=lambda kv: (int(kv[1][1]["w"]), kv[1][1]["mode"], kv[1][1]["f16"])):
+    parts.append(f"| {a['w']}x{a['h']} {MODES[a['mode']]} {'distance' if a['dist'] == '1' else 'depth'} | "
+                 f"{'f16' if a['f16'] == '1' else 'f32'} | " +
+                 " | ".join(f"{b[k]:.0f}" for k in ("create_us", "check_us", "enqueue_us", "wait_us", "device_us",
+                                                    "launch_us", "readback_us", "release_us")) +
+                 f" | {ms(b):.2f} | {b['parts_vs_device']:.2f} |")
+(out / "table.md").write_text("\n".join(lines) + "\n\n" + "\n".join(cache) + "\n\n" + "\n".join(parts) +
                               "\n\n| start-up and overhead | median |\n|---|---|\n" + "\n".join(extra) + "\n")
 print((out / "table.md").read_text())
