@@ -355,25 +355,39 @@ void BM_OpenCLHostCall(benchmark::State& state) {
   });
 }
 
-// Where a convenience call's time goes: FogPass::apply's steps on a CPU device as it ran them
-// before host-call caching (a USE_HOST_PTR buffer per image, created and released per call; the
-// blocking map, unmap and finish of the read-back), one by one, each timed on the host:
-//   create_us    three clCreateBuffer(CL_MEM_USE_HOST_PTR) on the images
-//   check_us     the integration API's checks (queue and buffer getInfo: context, device, sizes)
-//   enqueue_us   FogPass::enqueue (the same checks, 13 setArg, clEnqueueNDRangeKernel)
-//   wait_us      enqueue returned -> the kernel's event complete (clWaitForEvents)
-//   device_us    the kernel's profiling START -> END
-//   launch_us    its profiling QUEUED -> START (PoCL's scheduler and thread wake-up)
-//   readback_us  the blocking map, the unmap and clFinish after the kernel completed
-//   release_us   the three buffers released
-// The time is the call's (all but check_us, which enqueue_us contains); parts_vs_device = that /
-// device time.
+// Where a convenience call's time goes on a CPU device: FogPass::apply's steps, each timed on the
+// host, in four ways (range "way"):
+//   0  as apply ran them before host-call caching: three clCreateBuffer(CL_MEM_USE_HOST_PTR) on the
+//      images, the kernel, its event waited for, then a blocking map, the unmap and clFinish
+//   1  new buffers, the kernel, then one blocking clEnqueueReadBuffer into the output's own host
+//      pointer (the spec's defined read-back of a USE_HOST_PTR buffer: no map, no unmap, one wait)
+//   2  buffers kept across calls, each input made current by a non-blocking clEnqueueWriteBuffer
+//      from its own host pointer before the kernel, the read-back of way 1
+//   3  buffers kept across calls, no write before the kernel, the read-back of way 1
+//   4  apply's sequence before caching: new buffers, the kernel, a blocking map that waits for it
+//      (one wait), the unmap and clFinish
+//   5  buffers kept across calls and mapped between them (the host's, by the spec's protocol for
+//      USE_HOST_PTR memory the host changes): the three unmaps, the kernel, the three maps, the
+//      last blocking (one wait)
+//   6  buffers kept across calls, the kernel, the blocking map, the unmap and clFinish
+//   7  new buffers, the kernel, a non-blocking map and the unmap enqueued behind it, then one
+//      clFinish: the map's guarantee (USE_HOST_PTR: host_ptr holds the latest bits once the map
+//      completes) with a single wait
+// Counters [us per call]: create_us (buffers made or found), check_us (the integration API's checks:
+// queue and buffer getInfo), sync_us (way 2's writes enqueued), enqueue_us (FogPass::enqueue: checks,
+// 13 setArg, clEnqueueNDRangeKernel; the kernel often starts and runs before it returns), wait_us
+// (until the kernel's event completes: way 0; the blocking read-back: ways 1-3), readback_us (way 0's
+// map + unmap + finish), release_us, device_us (the kernel's profiling START -> END), launch_us (its
+// QUEUED -> START: PoCL's scheduler and worker wake-up). The time is the call's (all but check_us,
+// which enqueue_us contains); parts_vs_device = that / device time, the host call against the
+// kernel in the same iterations.
 void BM_HostCallParts(benchmark::State& state) {
   Runtime* rt = runtime(state);
   if (rt == nullptr) return;
   if (!rt->is_cpu()) return state.SkipWithError("host-call parts are measured on CPU devices");
   FogPass& pass = shared_pass(*rt);
   const Case c = case_of(state);
+  const int way = int(state.range(5));
   const DemoFrame& f = frame(c.w, c.h, c.format);
   ColorImage out(f.color.width(), f.color.height(), f.color.format());
   pass.prepare(c.settings, f.params, c.format);
@@ -381,44 +395,94 @@ void BM_HostCallParts(benchmark::State& state) {
   const cl::Context ctx = wrap(rt->context());
   const cl::CommandQueue queue = wrap(rt->queue());
   const cl::Device device = wrap(rt->device());
-  double create = 0, check = 0, enq = 0, wait = 0, dev = 0, launch = 0, read = 0, release = 0;
+  std::unique_ptr<detail::HostFrame> kept;
+  const bool keep = way == 2 || way == 3 || way == 5 || way == 6;
+  if (keep) kept = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+  void *mapped_in = nullptr, *mapped_depth = nullptr, *mapped_out = nullptr;  // way 5
+  double create = 0, check = 0, sync = 0, enq = 0, wait = 0, dev = 0, launch = 0, read = 0, release = 0;
   for (auto _ : state) {
     const auto begin = Clock::now();
     auto a = begin;
-    auto hf = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+    std::unique_ptr<detail::HostFrame> fresh;
+    if (!keep) fresh = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+    const detail::HostFrame& hf = keep ? *kept : *fresh;
     create += seconds_since(a);
     a = Clock::now();
     detail::checked_queue(queue(), ctx, device, "parts");
-    detail::check_frame_buffers(hf->raw, ctx);
+    detail::check_frame_buffers(hf.raw, ctx);
     const double check_seconds = seconds_since(a);
     check += check_seconds;
     a = Clock::now();
-    const cl::Event done = adopt(pass.enqueue(queue(), hf->raw, f.params, c.settings));
+    if (way == 2) {
+      queue.enqueueWriteBuffer(hf.color_in, CL_FALSE, 0, f.color.size_bytes(), f.color.data());
+      queue.enqueueWriteBuffer(hf.depth, CL_FALSE, 0, f.depth.size_bytes(), f.depth.data());
+    }
+    if (way == 5 && mapped_in != nullptr) {
+      queue.enqueueUnmapMemObject(hf.color_in, mapped_in);
+      queue.enqueueUnmapMemObject(hf.depth, mapped_depth);
+      queue.enqueueUnmapMemObject(hf.color_out, mapped_out);
+    }
+    sync += seconds_since(a);
+    a = Clock::now();
+    const cl::Event done = adopt(pass.enqueue(queue(), hf.raw, f.params, c.settings));
     enq += seconds_since(a);
     a = Clock::now();
-    done.wait();
-    wait += seconds_since(a);
+    if (way == 0) {
+      done.wait();
+      wait += seconds_since(a);
+      a = Clock::now();
+      void* mapped = queue.enqueueMapBuffer(hf.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes());
+      queue.enqueueUnmapMemObject(hf.color_out, mapped);
+      queue.finish();
+      read += seconds_since(a);
+    } else if (way == 4 || way == 6) {
+      const std::vector<cl::Event> after{done};
+      void* mapped = queue.enqueueMapBuffer(hf.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes(), &after);
+      wait += seconds_since(a);
+      a = Clock::now();
+      queue.enqueueUnmapMemObject(hf.color_out, mapped);
+      queue.finish();
+      read += seconds_since(a);
+    } else if (way == 7) {
+      const std::vector<cl::Event> after{done};
+      void* mapped = queue.enqueueMapBuffer(hf.color_out, CL_FALSE, CL_MAP_READ, 0, out.size_bytes(), &after);
+      queue.enqueueUnmapMemObject(hf.color_out, mapped);
+      queue.finish();
+      wait += seconds_since(a);
+    } else if (way == 5) {
+      mapped_in = queue.enqueueMapBuffer(hf.color_in, CL_FALSE, CL_MAP_WRITE, 0, f.color.size_bytes());
+      mapped_depth = queue.enqueueMapBuffer(hf.depth, CL_FALSE, CL_MAP_WRITE, 0, f.depth.size_bytes());
+      mapped_out = queue.enqueueMapBuffer(hf.color_out, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, out.size_bytes());
+      wait += seconds_since(a);
+    } else {
+      queue.enqueueReadBuffer(hf.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
+      wait += seconds_since(a);
+    }
     const auto queued = done.getProfilingInfo<CL_PROFILING_COMMAND_QUEUED>();
     const auto start = done.getProfilingInfo<CL_PROFILING_COMMAND_START>();
     dev += double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - start) * 1e-9;
     launch += double(start - queued) * 1e-9;
     a = Clock::now();
-    void* mapped = queue.enqueueMapBuffer(hf->color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes());
-    queue.enqueueUnmapMemObject(hf->color_out, mapped);
-    queue.finish();
-    read += seconds_since(a);
-    a = Clock::now();
-    hf.reset();
+    fresh.reset();
     release += seconds_since(a);
-    state.SetIterationTime(seconds_since(begin) - check_seconds);  // the call's time: the parts but the extra check
+    state.SetIterationTime(seconds_since(begin) - check_seconds);
+  }
+  if (mapped_in != nullptr) {
+    queue.enqueueUnmapMemObject(kept->color_in, mapped_in);
+    queue.enqueueUnmapMemObject(kept->depth, mapped_depth);
+    queue.enqueueUnmapMemObject(kept->color_out, mapped_out);
+    queue.finish();
   }
   const double n = double(state.iterations());
-  const double total = create + enq + wait + read + release;
-  for (auto [name, v] : {std::pair{"create_us", create}, {"check_us", check}, {"enqueue_us", enq}, {"wait_us", wait},
-                         {"device_us", dev}, {"launch_us", launch}, {"readback_us", read}, {"release_us", release}})
+  const double total = create + sync + enq + wait + read + release;
+  for (auto [name, v] : {std::pair{"create_us", create}, {"check_us", check}, {"sync_us", sync}, {"enqueue_us", enq},
+                         {"wait_us", wait}, {"device_us", dev}, {"launch_us", launch}, {"readback_us", read},
+                         {"release_us", release}})
     state.counters[name] = v / n * 1e6;
   state.counters["parts_vs_device"] = total / dev;
   state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(pass_bytes(f)));
+  // The output must be the pass's whatever the way (a read-back that copied nothing still has it).
+  state.counters["max_err"] = max_error(out, f, c.settings);
 }
 
 // Optical depth density * d across the frame ~ 10^range(0) at the demo scene's distances: 1 (f in
@@ -570,9 +634,10 @@ BENCHMARK(BM_OpenCLDevice)->Apply(DeviceArgs);
 BENCHMARK(BM_OpenCLDevice)->Name("BM_OpenCLDeviceCacheResident")->Apply(CacheResidentArgs);
 BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
 BENCHMARK(BM_HostCallParts)
-    ->ArgNames({"w", "h", "mode", "dist", "f16"})
-    ->ArgsProduct({{1920}, {1080}, {0, 2}, {0}, {0, 1}})
-    ->ArgsProduct({{3840}, {2160}, {0, 2}, {0}, {0, 1}})
+    ->ArgNames({"w", "h", "mode", "dist", "f16", "way"})
+    ->ArgsProduct({{64}, {64}, {2}, {0}, {0}, {0, 1, 2, 3, 4, 5, 6, 7}})
+    ->ArgsProduct({{1920}, {1080}, {0, 2}, {0}, {0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}})
+    ->ArgsProduct({{3840}, {2160}, {0, 2}, {0}, {0, 1}, {0, 4, 5, 6, 7}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2);
