@@ -26,6 +26,7 @@
 // platform, context, build, one 1080p frame; run it in a fresh process with an empty
 // POCL_CACHE_DIR for the cold figure). bench/run.sh runs everything, PoCL with 1 and 2 threads.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -485,6 +486,91 @@ void BM_HostCallParts(benchmark::State& state) {
   state.counters["max_err"] = max_error(out, f, c.settings);
 }
 
+// Linear against exp and exp2 fog under the same machine conditions: each iteration runs the three
+// modes back to back on the same 1080p/4K frame and zero-copy buffers (device time from profiling),
+// so DRAM noise of the shared VM moves all three alike; counters: each mode's median ms and the
+// ratios linear / exp2 and linear / exp. Also counted on the host (fogcl's scalar factors, the
+// kernel's bits): the share of 16-pixel blocks the kernel blends each way (fog_cpu_blocks.h):
+// all f = 1 (copy), all f = 0 (fog color), none at 0 or 1 (the mix alone), mixed (per-lane tests).
+void BM_ModeAB(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  if (!rt->is_cpu()) return state.SkipWithError("zero-copy buffers: a CPU device");
+  FogPass& pass = shared_pass(*rt);
+  const int w = int(state.range(0)), h = int(state.range(1));
+  const ColorFormat format = state.range(3) ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+  const DemoFrame& f = frame(w, h, format);
+  ColorImage out(w, h, format);
+  const cl::Context ctx = wrap(rt->context());
+  const cl::CommandQueue queue = wrap(rt->queue());
+  const detail::HostFrame hf = detail::host_frame(ctx, true, f.color, f.depth, out);
+  std::vector<FogSettings> modes;
+  for (int m = 0; m < 3; ++m) {
+    FogSettings s;
+    s.mode = m == 0 ? FogMode::linear : m == 1 ? FogMode::exp : FogMode::exp2;
+    s.start = 2.0f;
+    s.end = 70.0f;
+    s.density = 0.03f;
+    s.metric = state.range(2) ? FogMetric::distance : FogMetric::depth;
+    s.color = glm::vec3(0.62f, 0.68f, 0.76f);
+    pass.prepare(s, f.params, format);
+    adopt(pass.enqueue(queue(), hf.raw, f.params, s)).wait();
+    modes.push_back(s);
+  }
+  std::vector<double> t[3];
+  for (auto _ : state) {
+    double sum = 0;
+    for (int m = 0; m < 3; ++m) {
+      const cl::Event e = adopt(pass.enqueue(queue(), hf.raw, f.params, modes[m]));
+      e.wait();
+      const double sec =
+          double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
+      t[m].push_back(sec);
+      sum += sec;
+    }
+    state.SetIterationTime(sum);
+  }
+  const char* names[3] = {"linear_ms", "exp_ms", "exp2_ms"};
+  double med[3];
+  for (int m = 0; m < 3; ++m) {
+    std::sort(t[m].begin(), t[m].end());
+    med[m] = t[m][t[m].size() / 2];
+    state.counters[names[m]] = med[m] * 1e3;
+  }
+  state.counters["linear_vs_exp2"] = med[0] / med[2];
+  state.counters["linear_vs_exp"] = med[0] / med[1];
+  // Block classes from the scalar factors (probe: color 1, fog color 0, so the output is f).
+  static std::map<std::tuple<int, int, int>, std::array<double, 12>> classes;
+  auto& cls = classes[{w, h, int(state.range(2))}];
+  if (cls[0] + cls[1] + cls[2] + cls[3] == 0) {
+    ColorImage ones(w, h);
+    std::fill(ones.rgba32f(), ones.rgba32f() + 4 * std::size_t(w) * std::size_t(h), 1.0f);
+    for (int m = 0; m < 3; ++m) {
+      FogSettings probe = modes[m];
+      probe.color = glm::vec3(0.0f);
+      ColorImage fac;
+      apply_fog_scalar(ones, f.depth, fac, f.params, probe);
+      std::size_t n[4] = {0, 0, 0, 0};
+      for (int y = 0; y < h; ++y)
+        for (int x0 = 0; x0 < w; x0 += 16) {
+          int one = 0, zero = 0, len = std::min(16, w - x0);
+          for (int x = x0; x < x0 + len; ++x) {
+            const float v = fac.rgba32f()[4 * (std::size_t(y) * w + x)];
+            one += v == 1.0f;
+            zero += v == 0.0f;
+          }
+          ++n[one == len ? 0 : zero == len ? 1 : one + zero == 0 ? 2 : 3];
+        }
+      const double blocks = double(n[0] + n[1] + n[2] + n[3]);
+      for (int k = 0; k < 4; ++k) cls[4 * m + k] = n[k] / blocks;
+    }
+  }
+  const char* kinds[4] = {"copy", "fog", "mix", "lanes"};
+  for (int m = 0; m < 3; ++m)
+    for (int k = 0; k < 4; ++k)
+      state.counters[std::string(m == 0 ? "lin_" : m == 1 ? "exp_" : "exp2_") + kinds[k]] = cls[4 * m + k];
+}
+
 // Optical depth density * d across the frame ~ 10^range(0) at the demo scene's distances: 1 (f in
 // the normal range), 100 (exp(-100) = 4e-44: f is a float denormal), 1e3 and 1e20 (f underflows
 // to 0). Shows whether denormal factors slow the pass down (x86 microcode assists).
@@ -648,6 +734,13 @@ BENCHMARK(BM_DeviceCopy)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2);
+BENCHMARK(BM_ModeAB)
+    ->ArgNames({"w", "h", "dist", "f16"})
+    ->ArgsProduct({{1920}, {1080}, {0, 1}, {0, 1}})
+    ->ArgsProduct({{3840}, {2160}, {0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.3);
 BENCHMARK(BM_OpticalDepth)->ArgName("log10_density_d")->Arg(0)->Arg(2)->Arg(3)->Arg(20)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ProgramBuild)->ArgName("cold")->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_FirstDispatch)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);

@@ -92,7 +92,7 @@ lines = ["| frame | fog | storage | memcpy 2T ms (interleaved) | scalar ms | Ope
          "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 by_case = defaultdict(dict)
 for _, (n, a, b) in rows.items():
-    if "mode" in a:
+    if "mode" in a and n not in ("BM_HostCallParts", "BM_ModeAB"):
         # nt=1: the same device run with streaming stores (not the default), its own column.
         name = n + ("-nt" if a.get("nt") == "1" else "")
         by_case[(int(a["w"]), int(a["h"]), a["mode"], a["dist"], a["f16"])][name] = b
@@ -150,15 +150,28 @@ for (w, h, t), b in sorted(memcpy.items()):
         cache.append(f"| memcpy of the RGBA32F frame's bytes, {t} thread{'s' if t > 1 else ''} | | {ms(b) * 1e3:.1f} | "
                      f"{ms(b) * 1e6 * 16 / (w * h):.2f} | |")
 # Where the host call's time goes (BM_HostCallParts: apply's steps before buffer caching, timed apart).
-parts = ["| host call parts, µs | storage | create buffers | checks | enqueue | wait | device | queued -> start | "
-         "map + unmap + finish | release | call ms | call / device |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+# way: 0 before (separate wait, map, unmap, finish), 4 apply before, 7 apply now; see fog_bench.cpp.
+parts = ["| host call parts, µs | storage | way | create buffers | checks | writes | enqueue | wait | device | "
+         "queued -> start | unmap + finish (map too for way 0) | release | call ms | call / device |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 for name, (n, a, b) in sorted(((k, v) for k, v in rows.items() if v[0] == "BM_HostCallParts"),
-                              key=lambda kv: (int(kv[1][1]["w"]), kv[1][1]["mode"], kv[1][1]["f16"])):
+                              key=lambda kv: (int(kv[1][1]["w"]), kv[1][1]["mode"], kv[1][1]["f16"],
+                                              int(kv[1][1].get("way", "0")))):
     parts.append(f"| {a['w']}x{a['h']} {MODES[a['mode']]} {'distance' if a['dist'] == '1' else 'depth'} | "
-                 f"{'f16' if a['f16'] == '1' else 'f32'} | " +
-                 " | ".join(f"{b[k]:.0f}" for k in ("create_us", "check_us", "enqueue_us", "wait_us", "device_us",
-                                                    "launch_us", "readback_us", "release_us")) +
-                 f" | {ms(b):.2f} | {b['parts_vs_device']:.2f} |")
+                 f"{'f16' if a['f16'] == '1' else 'f32'} | {a.get('way', '0')} | " +
+                 " | ".join(f"{b[k]:.0f}" for k in ("create_us", "check_us", "sync_us", "enqueue_us", "wait_us",
+                                                    "device_us", "launch_us", "readback_us", "release_us")) +
+                 f" | {ms(b):.3f} | {b['parts_vs_device']:.2f} |")
+# Linear against exp and exp2 under the same conditions (BM_ModeAB) and the kernel's block classes.
+modes_ab = ["| frame | metric | storage | linear ms | exp ms | exp2 ms | linear / exp2 | blocks copy / fog / mix / "
+            "per-lane: linear | exp2 |", "|---|---|---|---|---|---|---|---|---|"]
+for name, (n, a, b) in sorted(((k, v) for k, v in rows.items() if v[0] == "BM_ModeAB"),
+                              key=lambda kv: (int(kv[1][1]["w"]), kv[1][1]["dist"], kv[1][1]["f16"])):
+    share = lambda p: " / ".join(f"{100 * b[p + k]:.1f}" for k in ("copy", "fog", "mix", "lanes"))
+    modes_ab.append(f"| {a['w']}x{a['h']} | {'distance' if a['dist'] == '1' else 'depth'} | "
+                    f"{'f16' if a['f16'] == '1' else 'f32'} | {b['linear_ms']:.2f} | {b['exp_ms']:.2f} | "
+                    f"{b['exp2_ms']:.2f} | {b['linear_vs_exp2']:.2f} | {share('lin_')} % | {share('exp2_')} % |")
+parts += [""] + modes_ab
 (out / "table.md").write_text("\n".join(lines) + "\n\n" + "\n".join(cache) + "\n\n" + "\n".join(parts) +
                               "\n\n| start-up and overhead | median |\n|---|---|\n" + "\n".join(extra) + "\n")
 print((out / "table.md").read_text())
