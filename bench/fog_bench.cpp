@@ -47,6 +47,8 @@
 #include "runtime/frame_buffers.h"
 #include "openmp_peer.h"
 #ifdef FOGCL_HAVE_HALIDE
+#include <dlfcn.h>
+
 #include "halide_peer.h"
 #endif
 
@@ -244,11 +246,37 @@ void BM_OpenMPSimdFastMath(benchmark::State& state) {
 }
 
 #ifdef FOGCL_HAVE_HALIDE
+// The Halide peer's module (bench/CMakeLists.txt), loaded on first use with its own LLVM kept out
+// of the global scope (RTLD_LOCAL, and RTLD_DEEPBIND so that it binds to its own dependencies).
+struct HalidePeer {
+  bench::HalidePrepare* prepare = nullptr;
+  bench::HalideFog* fog = nullptr;
+  std::string error;
+};
+
+const HalidePeer& halide_peer() {
+  static const HalidePeer peer = [] {
+    HalidePeer p;
+    void* module = dlopen(FOGCL_HALIDE_PEER_MODULE, RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND);
+    if (module == nullptr) {
+      p.error = std::string("cannot load the Halide peer: ") + dlerror();
+      return p;
+    }
+    p.prepare = reinterpret_cast<bench::HalidePrepare*>(dlsym(module, "fogcl_halide_prepare"));
+    p.fog = reinterpret_cast<bench::HalideFog*>(dlsym(module, "fogcl_halide_fog"));
+    if (p.prepare == nullptr || p.fog == nullptr) p.error = "the Halide peer module lacks its entry points";
+    return p;
+  }();
+  return peer;
+}
+
 void BM_Halide(benchmark::State& state) {
+  const HalidePeer& peer = halide_peer();
+  if (!peer.error.empty()) return state.SkipWithError(peer.error.c_str());
   const Case c = case_of(state);
-  bench::halide_prepare(frame(c.w, c.h, c.format).params, c.settings, c.format, kThreads);  // JIT, not timed
-  timed_fog(state, "halide", [](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
-    return host_time([&] { bench::halide_fog(f.color, f.depth, out, f.params, s, kThreads); });
+  peer.prepare(frame(c.w, c.h, c.format).params, c.settings, c.format, kThreads);  // JIT, not timed
+  timed_fog(state, "halide", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    return host_time([&] { peer.fog(f.color, f.depth, out, f.params, s, kThreads); });
   });
 }
 #endif

@@ -171,13 +171,20 @@ Pipeline& pipeline_for(const Variant& v, ColorFormat storage, int threads) {
 
 }  // namespace
 
-void halide_prepare(const CameraParams& camera, const FogSettings& settings, ColorFormat storage, int threads) {
+}  // namespace fogcl::bench
+
+using namespace fogcl;
+using fogcl::bench::Pipeline;
+using fogcl::bench::pipeline_for;
+
+extern "C" void fogcl_halide_prepare(const CameraParams& camera, const FogSettings& settings, ColorFormat storage,
+                                     int threads) {
   const Variant v = select_variant(settings, camera, storage);
   if (v.needs_pass()) pipeline_for(v, storage, threads);
 }
 
-void halide_fog(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
-                const FogSettings& settings, int threads) {
+extern "C" void fogcl_halide_fog(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                                 const CameraParams& camera, const FogSettings& settings, int threads) {
   const Variant v = select_variant(settings, camera, in.format());
   if (!v.needs_pass()) {
     out = in;
@@ -209,5 +216,3 @@ void halide_fog(const ColorImage& in, const DepthImage& depth, ColorImage& out, 
   p.depth.set(depth_in);
   p.pipeline.realize(color_out, p.target);
 }
-
-}  // namespace fogcl::bench

@@ -12,14 +12,20 @@
 
 namespace fogcl::bench {
 
-// JIT-compiles the pipeline of the variant `settings` and `camera` select for `storage` (once per
-// variant; later calls find it), so that the timed calls do not compile. `threads`: the size of
-// Halide's thread pool (HL_NUM_THREADS); it is read once, before the first pipeline runs.
-void halide_prepare(const CameraParams& camera, const FogSettings& settings, ColorFormat storage, int threads);
+// JIT-compiles (once per variant and storage; later calls find it) the pipeline of the variant
+// `settings` and `camera` select for `storage`, so that the timed calls do not compile. `threads`:
+// the size of Halide's thread pool (HL_NUM_THREADS); it is read once, before the first pipeline runs.
+using HalidePrepare = void(const CameraParams& camera, const FogSettings& settings, ColorFormat storage, int threads);
 
 // Fogs `in` into `out` (same size and format, allocated by the caller): one realize() of the
 // prepared pipeline (prepares it first if needed) on the images' own memory.
-void halide_fog(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
-                const FogSettings& settings, int threads);
+using HalideFog = void(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
+                       const FogSettings& settings, int threads);
 
 }  // namespace fogcl::bench
+
+// The module's entry points (bench/CMakeLists.txt builds it as a module that fog_bench.cpp loads
+// with dlopen: Halide's LLVM 14 must stay out of the global scope of a process that runs PoCL's
+// LLVM 15).
+extern "C" fogcl::bench::HalidePrepare fogcl_halide_prepare;
+extern "C" fogcl::bench::HalideFog fogcl_halide_fog;
