@@ -52,7 +52,8 @@ rows = medians(runs)
 # The cache-resident rows (512x256) get their own table below, not a place in the plot.
 cache_rows = {k: v for k, v in rows.items() if v[0] == "BM_OpenCLDeviceCacheResident"}
 rows = {k: v for k, v in rows.items() if v[0] != "BM_OpenCLDeviceCacheResident"}
-resolutions = sorted({(int(a["w"]), int(a["h"])) for _, (n, a, _) in rows.items() if "w" in a and "mode" in a},
+resolutions = sorted({(int(a["w"]), int(a["h"])) for _, (n, a, _) in rows.items()
+                      if "w" in a and "mode" in a and n not in ("BM_HostCallParts", "BM_ModeAB")},
                      key=lambda r: r[0] * r[1])
 memcpy = {(int(a["w"]), int(a["h"]), int(a["threads"])): b for _, (n, a, b) in rows.items() if n == "BM_Memcpy"}
 
