@@ -6,6 +6,8 @@
 //   BM_Scalar            fogcl's scalar C++ path (one thread, as built for users)
 //   BM_OpenMPSimd        the OpenMP + SIMD C++ peer (-O3 -march=native, 2 threads)
 //   BM_OpenMPSimdFastMath  the same with -ffast-math (vectorised exp2; no NaN/Inf guarantees)
+//   BM_Halide            the Halide 14 peer (JIT for the host, 2 threads; built when Halide is
+//                        found): one whole realize() per iteration, compiled before the loop
 //   BM_OpenCLDevice      the OpenCL pass, zero-copy buffers, device time from profiling events
 //   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish); on a
 //                        GPU the host round trip: upload + kernel + download
@@ -24,6 +26,7 @@
 // platform, context, build, one 1080p frame; run it in a fresh process with an empty
 // POCL_CACHE_DIR for the cold figure). bench/run.sh runs everything, PoCL with 1 and 2 threads.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -41,7 +44,13 @@
 #include "fogcl/demo_scene.h"
 #include "fogcl/fogcl.h"
 #include "runtime/clhpp.h"
+#include "runtime/frame_buffers.h"
 #include "openmp_peer.h"
+#ifdef FOGCL_HAVE_HALIDE
+#include <dlfcn.h>
+
+#include "halide_peer.h"
+#endif
 
 namespace {
 
@@ -236,6 +245,42 @@ void BM_OpenMPSimdFastMath(benchmark::State& state) {
   });
 }
 
+#ifdef FOGCL_HAVE_HALIDE
+// The Halide peer's module (bench/CMakeLists.txt), loaded on first use with its own LLVM kept out
+// of the global scope (RTLD_LOCAL, and RTLD_DEEPBIND so that it binds to its own dependencies).
+struct HalidePeer {
+  bench::HalidePrepare* prepare = nullptr;
+  bench::HalideFog* fog = nullptr;
+  std::string error;
+};
+
+const HalidePeer& halide_peer() {
+  static const HalidePeer peer = [] {
+    HalidePeer p;
+    void* module = dlopen(FOGCL_HALIDE_PEER_MODULE, RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND);
+    if (module == nullptr) {
+      p.error = std::string("cannot load the Halide peer: ") + dlerror();
+      return p;
+    }
+    p.prepare = reinterpret_cast<bench::HalidePrepare*>(dlsym(module, "fogcl_halide_prepare"));
+    p.fog = reinterpret_cast<bench::HalideFog*>(dlsym(module, "fogcl_halide_fog"));
+    if (p.prepare == nullptr || p.fog == nullptr) p.error = "the Halide peer module lacks its entry points";
+    return p;
+  }();
+  return peer;
+}
+
+void BM_Halide(benchmark::State& state) {
+  const HalidePeer& peer = halide_peer();
+  if (!peer.error.empty()) return state.SkipWithError(peer.error.c_str());
+  const Case c = case_of(state);
+  peer.prepare(frame(c.w, c.h, c.format).params, c.settings, c.format, kThreads);  // JIT, not timed
+  timed_fog(state, "halide", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    return host_time([&] { peer.fog(f.color, f.depth, out, f.params, s, kThreads); });
+  });
+}
+#endif
+
 Runtime* runtime(benchmark::State& state) {
   static std::unique_ptr<Runtime> rt;
   static std::string error;
@@ -337,6 +382,221 @@ void BM_OpenCLHostCall(benchmark::State& state) {
   timed_fog(state, "opencl-host", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     return host_time([&] { pass.apply(f.color, f.depth, out, f.params, s); });
   });
+}
+
+// Where a convenience call's time goes on a CPU device: FogPass::apply's steps, each timed on the
+// host, in four ways (range "way"):
+//   0  as apply ran them before host-call caching: three clCreateBuffer(CL_MEM_USE_HOST_PTR) on the
+//      images, the kernel, its event waited for, then a blocking map, the unmap and clFinish
+//   1  new buffers, the kernel, then one blocking clEnqueueReadBuffer into the output's own host
+//      pointer (the spec's defined read-back of a USE_HOST_PTR buffer: no map, no unmap, one wait)
+//   2  buffers kept across calls, each input made current by a non-blocking clEnqueueWriteBuffer
+//      from its own host pointer before the kernel, the read-back of way 1
+//   3  buffers kept across calls, no write before the kernel, the read-back of way 1
+//   4  apply's sequence before caching: new buffers, the kernel, a blocking map that waits for it
+//      (one wait), the unmap and clFinish
+//   5  buffers kept across calls and mapped between them (the host's, by the spec's protocol for
+//      USE_HOST_PTR memory the host changes): the three unmaps, the kernel, the three maps, the
+//      last blocking (one wait)
+//   6  buffers kept across calls, the kernel, the blocking map, the unmap and clFinish
+//   7  new buffers, the kernel, a non-blocking map and the unmap enqueued behind it, then one
+//      clFinish: the map's guarantee (USE_HOST_PTR: host_ptr holds the latest bits once the map
+//      completes) with a single wait
+// Counters [us per call]: create_us (buffers made or found), check_us (the integration API's checks:
+// queue and buffer getInfo), sync_us (way 2's writes enqueued), enqueue_us (FogPass::enqueue: checks,
+// 13 setArg, clEnqueueNDRangeKernel; the kernel often starts and runs before it returns), wait_us
+// (until the kernel's event completes: way 0; the blocking read-back: ways 1-3), readback_us (way 0's
+// map + unmap + finish), release_us, device_us (the kernel's profiling START -> END), launch_us (its
+// QUEUED -> START: PoCL's scheduler and worker wake-up). The time is the call's (all but check_us,
+// which enqueue_us contains); parts_vs_device = that / device time, the host call against the
+// kernel in the same iterations.
+void BM_HostCallParts(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  if (!rt->is_cpu()) return state.SkipWithError("host-call parts are measured on CPU devices");
+  FogPass& pass = shared_pass(*rt);
+  const Case c = case_of(state);
+  const int way = int(state.range(5));
+  const DemoFrame& f = frame(c.w, c.h, c.format);
+  ColorImage out(f.color.width(), f.color.height(), f.color.format());
+  pass.prepare(c.settings, f.params, c.format);
+  pass.apply(f.color, f.depth, out, f.params, c.settings);  // first touch of `out`
+  const cl::Context ctx = wrap(rt->context());
+  const cl::CommandQueue queue = wrap(rt->queue());
+  const cl::Device device = wrap(rt->device());
+  std::unique_ptr<detail::HostFrame> kept;
+  const bool keep = way == 2 || way == 3 || way == 5 || way == 6;
+  if (keep) kept = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+  void *mapped_in = nullptr, *mapped_depth = nullptr, *mapped_out = nullptr;  // way 5
+  double create = 0, check = 0, sync = 0, enq = 0, wait = 0, dev = 0, launch = 0, read = 0, release = 0;
+  for (auto _ : state) {
+    const auto begin = Clock::now();
+    auto a = begin;
+    std::unique_ptr<detail::HostFrame> fresh;
+    if (!keep) fresh = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+    const detail::HostFrame& hf = keep ? *kept : *fresh;
+    create += seconds_since(a);
+    a = Clock::now();
+    detail::checked_queue(queue(), ctx, device, "parts");
+    detail::check_frame_buffers(hf.raw, ctx);
+    const double check_seconds = seconds_since(a);
+    check += check_seconds;
+    a = Clock::now();
+    if (way == 2) {
+      queue.enqueueWriteBuffer(hf.color_in, CL_FALSE, 0, f.color.size_bytes(), f.color.data());
+      queue.enqueueWriteBuffer(hf.depth, CL_FALSE, 0, f.depth.size_bytes(), f.depth.data());
+    }
+    if (way == 5 && mapped_in != nullptr) {
+      queue.enqueueUnmapMemObject(hf.color_in, mapped_in);
+      queue.enqueueUnmapMemObject(hf.depth, mapped_depth);
+      queue.enqueueUnmapMemObject(hf.color_out, mapped_out);
+    }
+    sync += seconds_since(a);
+    a = Clock::now();
+    const cl::Event done = adopt(pass.enqueue(queue(), hf.raw, f.params, c.settings));
+    enq += seconds_since(a);
+    a = Clock::now();
+    if (way == 0) {
+      done.wait();
+      wait += seconds_since(a);
+      a = Clock::now();
+      void* mapped = queue.enqueueMapBuffer(hf.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes());
+      queue.enqueueUnmapMemObject(hf.color_out, mapped);
+      queue.finish();
+      read += seconds_since(a);
+    } else if (way == 4 || way == 6) {
+      const std::vector<cl::Event> after{done};
+      void* mapped = queue.enqueueMapBuffer(hf.color_out, CL_TRUE, CL_MAP_READ, 0, out.size_bytes(), &after);
+      wait += seconds_since(a);
+      a = Clock::now();
+      queue.enqueueUnmapMemObject(hf.color_out, mapped);
+      queue.finish();
+      read += seconds_since(a);
+    } else if (way == 7) {
+      const std::vector<cl::Event> after{done};
+      void* mapped = queue.enqueueMapBuffer(hf.color_out, CL_FALSE, CL_MAP_READ, 0, out.size_bytes(), &after);
+      queue.enqueueUnmapMemObject(hf.color_out, mapped);
+      queue.finish();
+      wait += seconds_since(a);
+    } else if (way == 5) {
+      mapped_in = queue.enqueueMapBuffer(hf.color_in, CL_FALSE, CL_MAP_WRITE, 0, f.color.size_bytes());
+      mapped_depth = queue.enqueueMapBuffer(hf.depth, CL_FALSE, CL_MAP_WRITE, 0, f.depth.size_bytes());
+      mapped_out = queue.enqueueMapBuffer(hf.color_out, CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, out.size_bytes());
+      wait += seconds_since(a);
+    } else {
+      queue.enqueueReadBuffer(hf.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
+      wait += seconds_since(a);
+    }
+    const auto queued = done.getProfilingInfo<CL_PROFILING_COMMAND_QUEUED>();
+    const auto start = done.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+    dev += double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() - start) * 1e-9;
+    launch += double(start - queued) * 1e-9;
+    a = Clock::now();
+    fresh.reset();
+    release += seconds_since(a);
+    state.SetIterationTime(seconds_since(begin) - check_seconds);
+  }
+  if (mapped_in != nullptr) {
+    queue.enqueueUnmapMemObject(kept->color_in, mapped_in);
+    queue.enqueueUnmapMemObject(kept->depth, mapped_depth);
+    queue.enqueueUnmapMemObject(kept->color_out, mapped_out);
+    queue.finish();
+  }
+  const double n = double(state.iterations());
+  const double total = create + sync + enq + wait + read + release;
+  for (auto [name, v] : {std::pair{"create_us", create}, {"check_us", check}, {"sync_us", sync}, {"enqueue_us", enq},
+                         {"wait_us", wait}, {"device_us", dev}, {"launch_us", launch}, {"readback_us", read},
+                         {"release_us", release}})
+    state.counters[name] = v / n * 1e6;
+  state.counters["parts_vs_device"] = total / dev;
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(pass_bytes(f)));
+  // The output must be the pass's whatever the way (a read-back that copied nothing still has it).
+  state.counters["max_err"] = max_error(out, f, c.settings);
+}
+
+// Linear against exp and exp2 fog under the same machine conditions: each iteration runs the three
+// modes back to back on the same 1080p/4K frame and zero-copy buffers (device time from profiling),
+// so DRAM noise of the shared VM moves all three alike; counters: each mode's median ms and the
+// ratios linear / exp2 and linear / exp. Also counted on the host (fogcl's scalar factors, the
+// kernel's bits): the share of 16-pixel blocks the kernel blends each way (fog_cpu_blocks.h):
+// all f = 1 (copy), all f = 0 (fog color), none at 0 or 1 (the mix alone), mixed (per-lane tests).
+void BM_ModeAB(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  if (!rt->is_cpu()) return state.SkipWithError("zero-copy buffers: a CPU device");
+  FogPass& pass = shared_pass(*rt);
+  const int w = int(state.range(0)), h = int(state.range(1));
+  const ColorFormat format = state.range(3) ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+  const DemoFrame& f = frame(w, h, format);
+  ColorImage out(w, h, format);
+  const cl::Context ctx = wrap(rt->context());
+  const cl::CommandQueue queue = wrap(rt->queue());
+  const detail::HostFrame hf = detail::host_frame(ctx, true, f.color, f.depth, out);
+  std::vector<FogSettings> modes;
+  for (int m = 0; m < 3; ++m) {
+    FogSettings s;
+    s.mode = m == 0 ? FogMode::linear : m == 1 ? FogMode::exp : FogMode::exp2;
+    s.start = 2.0f;
+    s.end = 70.0f;
+    s.density = 0.03f;
+    s.metric = state.range(2) ? FogMetric::distance : FogMetric::depth;
+    s.color = glm::vec3(0.62f, 0.68f, 0.76f);
+    pass.prepare(s, f.params, format);
+    adopt(pass.enqueue(queue(), hf.raw, f.params, s)).wait();
+    modes.push_back(s);
+  }
+  std::vector<double> t[3];
+  for (auto _ : state) {
+    double sum = 0;
+    for (int m = 0; m < 3; ++m) {
+      const cl::Event e = adopt(pass.enqueue(queue(), hf.raw, f.params, modes[m]));
+      e.wait();
+      const double sec =
+          double(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() - e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-9;
+      t[m].push_back(sec);
+      sum += sec;
+    }
+    state.SetIterationTime(sum);
+  }
+  const char* names[3] = {"linear_ms", "exp_ms", "exp2_ms"};
+  double med[3];
+  for (int m = 0; m < 3; ++m) {
+    std::sort(t[m].begin(), t[m].end());
+    med[m] = t[m][t[m].size() / 2];
+    state.counters[names[m]] = med[m] * 1e3;
+  }
+  state.counters["linear_vs_exp2"] = med[0] / med[2];
+  state.counters["linear_vs_exp"] = med[0] / med[1];
+  // Block classes from the scalar factors (probe: color 1, fog color 0, so the output is f).
+  static std::map<std::tuple<int, int, int>, std::array<double, 12>> classes;
+  auto& cls = classes[{w, h, int(state.range(2))}];
+  if (cls[0] + cls[1] + cls[2] + cls[3] == 0) {
+    ColorImage ones(w, h);
+    std::fill(ones.rgba32f(), ones.rgba32f() + 4 * std::size_t(w) * std::size_t(h), 1.0f);
+    for (int m = 0; m < 3; ++m) {
+      FogSettings probe = modes[m];
+      probe.color = glm::vec3(0.0f);
+      ColorImage fac;
+      apply_fog_scalar(ones, f.depth, fac, f.params, probe);
+      std::size_t n[4] = {0, 0, 0, 0};
+      for (int y = 0; y < h; ++y)
+        for (int x0 = 0; x0 < w; x0 += 16) {
+          int one = 0, zero = 0, len = std::min(16, w - x0);
+          for (int x = x0; x < x0 + len; ++x) {
+            const float v = fac.rgba32f()[4 * (std::size_t(y) * w + x)];
+            one += v == 1.0f;
+            zero += v == 0.0f;
+          }
+          ++n[one == len ? 0 : zero == len ? 1 : one + zero == 0 ? 2 : 3];
+        }
+      const double blocks = double(n[0] + n[1] + n[2] + n[3]);
+      for (int k = 0; k < 4; ++k) cls[4 * m + k] = n[k] / blocks;
+    }
+  }
+  const char* kinds[4] = {"copy", "fog", "mix", "lanes"};
+  for (int m = 0; m < 3; ++m)
+    for (int k = 0; k < 4; ++k)
+      state.counters[std::string(m == 0 ? "lin_" : m == 1 ? "exp_" : "exp2_") + kinds[k]] = cls[4 * m + k];
 }
 
 // Optical depth density * d across the frame ~ 10^range(0) at the demo scene's distances: 1 (f in
@@ -481,9 +741,20 @@ BENCHMARK(BM_Memcpy)->Apply(MemcpyArgs);
 BENCHMARK(BM_Scalar)->Apply(FogArgs);
 BENCHMARK(BM_OpenMPSimd)->Apply(FogArgs);
 BENCHMARK(BM_OpenMPSimdFastMath)->Apply(FogArgs);
+#ifdef FOGCL_HAVE_HALIDE
+BENCHMARK(BM_Halide)->Apply(FogArgs);
+#endif
 BENCHMARK(BM_OpenCLDevice)->Apply(DeviceArgs);
 BENCHMARK(BM_OpenCLDevice)->Name("BM_OpenCLDeviceCacheResident")->Apply(CacheResidentArgs);
 BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
+BENCHMARK(BM_HostCallParts)
+    ->ArgNames({"w", "h", "mode", "dist", "f16", "way"})
+    ->ArgsProduct({{64}, {64}, {2}, {0}, {0}, {0, 1, 2, 3, 4, 5, 6, 7}})
+    ->ArgsProduct({{1920}, {1080}, {0, 2}, {0}, {0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}})
+    ->ArgsProduct({{3840}, {2160}, {0, 2}, {0}, {0, 1}, {0, 4, 5, 6, 7}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2);
 BENCHMARK(BM_DeviceCopy)
     ->ArgNames({"w", "h", "f16"})
     ->ArgsProduct({{1920}, {1080}, {0, 1}})
@@ -491,6 +762,13 @@ BENCHMARK(BM_DeviceCopy)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2);
+BENCHMARK(BM_ModeAB)
+    ->ArgNames({"w", "h", "dist", "f16"})
+    ->ArgsProduct({{1920}, {1080}, {0, 1}, {0, 1}})
+    ->ArgsProduct({{3840}, {2160}, {0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.3);
 BENCHMARK(BM_OpticalDepth)->ArgName("log10_density_d")->Arg(0)->Arg(2)->Arg(3)->Arg(20)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ProgramBuild)->ArgName("cold")->Arg(1)->Arg(0)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_FirstDispatch)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);

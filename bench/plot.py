@@ -21,6 +21,7 @@ PATHS = {
     "BM_Scalar": "scalar C++ (1 thread)",
     "BM_OpenMPSimd": "OpenMP+SIMD C++ (2 threads)",
     "BM_OpenMPSimdFastMath": "OpenMP+SIMD -ffast-math (2 threads)",
+    "BM_Halide": "Halide 14 JIT (2 threads)",
     "BM_OpenCLDevice": "OpenCL PoCL, device time",
     "BM_OpenCLHostCall": "OpenCL PoCL, host call",
 }
@@ -51,7 +52,8 @@ rows = medians(runs)
 # The cache-resident rows (512x256) get their own table below, not a place in the plot.
 cache_rows = {k: v for k, v in rows.items() if v[0] == "BM_OpenCLDeviceCacheResident"}
 rows = {k: v for k, v in rows.items() if v[0] != "BM_OpenCLDeviceCacheResident"}
-resolutions = sorted({(int(a["w"]), int(a["h"])) for _, (n, a, _) in rows.items() if "w" in a and "mode" in a},
+resolutions = sorted({(int(a["w"]), int(a["h"])) for _, (n, a, _) in rows.items()
+                      if "w" in a and "mode" in a and n not in ("BM_HostCallParts", "BM_ModeAB")},
                      key=lambda r: r[0] * r[1])
 memcpy = {(int(a["w"]), int(a["h"]), int(a["threads"])): b for _, (n, a, b) in rows.items() if n == "BM_Memcpy"}
 
@@ -82,11 +84,16 @@ fig.tight_layout()
 fig.savefig(out / "throughput.png", dpi=110)
 
 # Table: per resolution / mode / metric / storage: ms and ratio to memcpy2 for each path.
-lines = ["| frame | fog | storage | memcpy 2T ms (interleaved) | scalar ms | OpenMP ms | OpenMP fast-math ms | OpenCL device ms | OpenCL device, streaming stores ms | OpenCL host call ms | OpenCL / memcpy2 | OpenCL vs scalar | max err (OpenCL) |",
-         "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+# The Halide peer's own error sits next to its time; host call / device and host call / Halide are
+# the ratios of the host-call targets (the same run).
+lines = ["| frame | fog | storage | memcpy 2T ms (interleaved) | scalar ms | OpenMP ms | OpenMP fast-math ms | Halide ms | "
+         "OpenCL device ms | OpenCL device, streaming stores ms | OpenCL host call ms | host call / device | "
+         "host call / Halide | OpenCL / memcpy2 | host call / memcpy2 | Halide / memcpy2 | OpenCL vs scalar | "
+         "max err (OpenCL) | max err (Halide) |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
 by_case = defaultdict(dict)
 for _, (n, a, b) in rows.items():
-    if "mode" in a:
+    if "mode" in a and n not in ("BM_HostCallParts", "BM_ModeAB"):
         # nt=1: the same device run with streaming stores (not the default), its own column.
         name = n + ("-nt" if a.get("nt") == "1" else "")
         by_case[(int(a["w"]), int(a["h"]), a["mode"], a["dist"], a["f16"])][name] = b
@@ -98,11 +105,19 @@ for (w, h, mode, dist, f16), paths in sorted(by_case.items(), key=lambda kv: (kv
     ratio = f"{cl['vs_memcpy2']:.2f}" if cl else "-"
     speedup = f"{ms(sc) / ms(cl):.1f}x" if cl and sc else "-"
     err = f"{cl['max_err']:.1e}" if cl else "-"
+    hc = paths.get("BM_OpenCLHostCall")
+    hl = paths.get("BM_Halide")
+    hc_dev = f"{ms(hc) / ms(cl):.2f}" if hc and cl else "-"
+    hc_hl = f"{ms(hc) / ms(hl):.2f}" if hc and hl else "-"
+    hc_m2 = f"{hc['vs_memcpy2']:.2f}" if hc else "-"
+    hl_m2 = f"{hl['vs_memcpy2']:.2f}" if hl else "-"
+    hl_err = f"{hl['max_err']:.1e}" if hl else "-"
     # The ceiling the ratio used: the 2-thread memcpy measured interleaved with the OpenCL rows.
     m2 = f"{cl['memcpy2_ms']:.2f}" if cl and "memcpy2_ms" in cl else "-"
     lines.append(f"| {w}x{h} | {MODES[mode]} {'distance' if dist == '1' else 'depth'} | {'f16' if f16 == '1' else 'f32'} | "
-                 f"{m2} | {t('BM_Scalar')} | {t('BM_OpenMPSimd')} | {t('BM_OpenMPSimdFastMath')} | {t('BM_OpenCLDevice')} | "
-                 f"{t('BM_OpenCLDevice-nt')} | {t('BM_OpenCLHostCall')} | {ratio} | {speedup} | {err} |")
+                 f"{m2} | {t('BM_Scalar')} | {t('BM_OpenMPSimd')} | {t('BM_OpenMPSimdFastMath')} | {t('BM_Halide')} | "
+                 f"{t('BM_OpenCLDevice')} | {t('BM_OpenCLDevice-nt')} | {t('BM_OpenCLHostCall')} | {hc_dev} | {hc_hl} | "
+                 f"{ratio} | {hc_m2} | {hl_m2} | {speedup} | {err} | {hl_err} |")
 
 extra = []
 for _, (n, a, b) in rows.items():
@@ -135,6 +150,29 @@ for (w, h, t), b in sorted(memcpy.items()):
     if (w, h) == (512, 256):
         cache.append(f"| memcpy of the RGBA32F frame's bytes, {t} thread{'s' if t > 1 else ''} | | {ms(b) * 1e3:.1f} | "
                      f"{ms(b) * 1e6 * 16 / (w * h):.2f} | |")
-(out / "table.md").write_text("\n".join(lines) + "\n\n" + "\n".join(cache) +
+# Where the host call's time goes (BM_HostCallParts: apply's steps before buffer caching, timed apart).
+# way: 0 before (separate wait, map, unmap, finish), 4 apply before, 7 apply now; see fog_bench.cpp.
+parts = ["| host call parts, µs | storage | way | create buffers | checks | writes | enqueue | wait | device | "
+         "queued -> start | unmap + finish (map too for way 0) | release | call ms | call / device |",
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+for name, (n, a, b) in sorted(((k, v) for k, v in rows.items() if v[0] == "BM_HostCallParts"),
+                              key=lambda kv: (int(kv[1][1]["w"]), kv[1][1]["mode"], kv[1][1]["f16"],
+                                              int(kv[1][1].get("way", "0")))):
+    parts.append(f"| {a['w']}x{a['h']} {MODES[a['mode']]} {'distance' if a['dist'] == '1' else 'depth'} | "
+                 f"{'f16' if a['f16'] == '1' else 'f32'} | {a.get('way', '0')} | " +
+                 " | ".join(f"{b[k]:.0f}" for k in ("create_us", "check_us", "sync_us", "enqueue_us", "wait_us",
+                                                    "device_us", "launch_us", "readback_us", "release_us")) +
+                 f" | {ms(b):.3f} | {b['parts_vs_device']:.2f} |")
+# Linear against exp and exp2 under the same conditions (BM_ModeAB) and the kernel's block classes.
+modes_ab = ["| frame | metric | storage | linear ms | exp ms | exp2 ms | linear / exp2 | blocks copy / fog / mix / "
+            "per-lane: linear | exp2 |", "|---|---|---|---|---|---|---|---|---|"]
+for name, (n, a, b) in sorted(((k, v) for k, v in rows.items() if v[0] == "BM_ModeAB"),
+                              key=lambda kv: (int(kv[1][1]["w"]), kv[1][1]["dist"], kv[1][1]["f16"])):
+    share = lambda p: " / ".join(f"{100 * b[p + k]:.1f}" for k in ("copy", "fog", "mix", "lanes"))
+    modes_ab.append(f"| {a['w']}x{a['h']} | {'distance' if a['dist'] == '1' else 'depth'} | "
+                    f"{'f16' if a['f16'] == '1' else 'f32'} | {b['linear_ms']:.2f} | {b['exp_ms']:.2f} | "
+                    f"{b['exp2_ms']:.2f} | {b['linear_vs_exp2']:.2f} | {share('lin_')} % | {share('exp2_')} % |")
+parts += [""] + modes_ab
+(out / "table.md").write_text("\n".join(lines) + "\n\n" + "\n".join(cache) + "\n\n" + "\n".join(parts) +
                               "\n\n| start-up and overhead | median |\n|---|---|\n" + "\n".join(extra) + "\n")
 print((out / "table.md").read_text())

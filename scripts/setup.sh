@@ -11,9 +11,10 @@ packages=(
 if [ "${1:-}" = "--sanitizers" ]; then
   packages+=(clang-14 libclang-rt-14-dev)
 fi
-# --bench: also matplotlib, which bench/plot.py draws the throughput plot with.
+# --bench: also matplotlib, which bench/plot.py draws the throughput plot with, and Halide 14 for the
+# Halide peer (bench/halide_peer.cpp; the bench builds it only when Halide is found).
 if [ "${1:-}" = "--bench" ]; then
-  packages+=(python3-matplotlib)
+  packages+=(python3-matplotlib libhalide14-0-dev)
 fi
 missing=()
 for p in "${packages[@]}"; do

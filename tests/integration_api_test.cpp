@@ -265,6 +265,75 @@ TEST_F(IntegrationApi, ConvenienceUsesHostMemoryOnCpuDevices) {
   EXPECT_EQ(std::memcmp(image.data(), out.data(), out.size_bytes()), 0);
 }
 
+// apply() on images the caller keeps and changes between calls, as a renderer does every frame:
+// new contents at the same addresses, `out` reused as the next input and in place, images freed
+// and allocated again (often at the same address and size), another size in between, both
+// storages. Each output must be the one a new pass gives on fresh copies of the same inputs, bit
+// for bit: no call may see the buffers, contents or results of an earlier one.
+TEST_F(IntegrationApi, ConvenienceFollowsReusedAndReallocatedImages) {
+  for (ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
+    SCOPED_TRACE(to_string(format));
+    const TestFrame a = make_test_frame(97, 61, false, format, 3);
+    const TestFrame b = make_test_frame(97, 61, false, format, 11);
+    const TestFrame small = make_test_frame(40, 24, false, format, 5);
+    // The reference: a pass of its own on images of its own.
+    const auto fresh = [&](const ColorImage& in, const DepthImage& depth) {
+      const ColorImage in_copy = in;
+      const DepthImage depth_copy = depth;
+      ColorImage out;
+      FogPass(*runtime()).apply(in_copy, depth_copy, out, a.params, settings);
+      return out;
+    };
+    const auto same = [](const ColorImage& x, const ColorImage& y) {
+      return x.width() == y.width() && x.height() == y.height() && x.format() == y.format() &&
+             std::memcmp(x.data(), y.data(), x.size_bytes()) == 0;
+    };
+    ASSERT_FALSE(same(fresh(a.color, a.depth), fresh(b.color, b.depth)));  // the frames tell calls apart
+
+    FogPass pass(*runtime());
+    ColorImage in = a.color, out;
+    DepthImage depth = a.depth;
+    pass.apply(in, depth, out, a.params, settings);
+    EXPECT_TRUE(same(out, fresh(a.color, a.depth))) << "first call";
+    const void* in_at = in.data();
+    const void* out_at = out.data();
+
+    // New contents at the same addresses (the same images, written by the caller).
+    std::memcpy(in.data(), b.color.data(), in.size_bytes());
+    std::memcpy(depth.data(), b.depth.data(), depth.size_bytes());
+    pass.apply(in, depth, out, a.params, settings);
+    ASSERT_EQ(in.data(), in_at);
+    ASSERT_EQ(out.data(), out_at);
+    EXPECT_TRUE(same(out, fresh(b.color, b.depth))) << "same images, new contents";
+
+    // The output as the next input (fog applied twice), then in place on the caller's image.
+    ColorImage twice;
+    pass.apply(out, depth, twice, a.params, settings);
+    EXPECT_TRUE(same(twice, fresh(fresh(b.color, b.depth), b.depth))) << "output as input";
+    ColorImage image = a.color;
+    pass.apply(image, a.depth, image, a.params, settings);
+    EXPECT_TRUE(same(image, fresh(a.color, a.depth))) << "in place";
+
+    // Images freed and allocated again: the allocator often returns the same address and size.
+    for (int round = 0; round < 3; ++round) {
+      const TestFrame& src = round % 2 ? a : b;
+      in = ColorImage();
+      out = ColorImage();
+      depth = DepthImage();
+      in = src.color;
+      depth = src.depth;
+      pass.apply(in, depth, out, a.params, settings);
+      EXPECT_TRUE(same(out, fresh(src.color, src.depth))) << "reallocated, round " << round;
+    }
+
+    // Another size in between, into the same `out` (apply reallocates it), then back.
+    pass.apply(small.color, small.depth, out, a.params, settings);
+    EXPECT_TRUE(same(out, fresh(small.color, small.depth))) << "smaller frame";
+    pass.apply(a.color, a.depth, out, a.params, settings);
+    EXPECT_TRUE(same(out, fresh(a.color, a.depth))) << "back to the first size";
+  }
+}
+
 TEST_F(IntegrationApi, ConvenienceRejectsMismatchedImagesBeforeAnyWork) {
   FogPass pass(*runtime());
   ColorImage out;

@@ -39,6 +39,11 @@ struct FogPass::Impl {
   Variant last_variant;
 
   cl::Kernel* find_kernel(const Variant& variant);
+  // enqueue() after its checks: the variant `v` of (settings, camera, fb.format), a queue of the
+  // pass's context and device, buffers of the frame's sizes. apply() comes here directly: its
+  // buffers are made for the frame (frame_buffers.h) and its queue is the pass's own.
+  cl_event dispatch(const cl::CommandQueue& queue, const FrameBuffers& fb, const Variant& v,
+                    const CameraParams& camera, const FogSettings& settings, const std::vector<cl_event>& wait_list);
 };
 
 FogPass::FogPass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs,
@@ -119,50 +124,55 @@ cl_event FogPass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb,
                 std::to_string(fb.height) + ")");
   validate(camera);
   const Variant v = select_variant(settings, camera, fb.format);
-  const std::size_t color_bytes = color_buffer_bytes(fb.width, fb.height, fb.format);
   return with_cl_errors([&] {
     const cl::CommandQueue queue = detail::checked_queue(queue_handle, m.context, m.device, "FogPass::enqueue");
     detail::check_frame_buffers(fb, m.context);
-    cl::Kernel* kernel = v.needs_pass() ? m.find_kernel(v) : nullptr;
-    if (v.needs_pass() && kernel == nullptr)
-      throw Error("fog variant '" + describe(v) + "' is not prepared: call FogPass::prepare(settings, camera, " +
-                  to_string(fb.format) + ") (or prepare(variant)) before enqueue, which never builds a program");
-    std::vector<cl::Event> waits_storage;
-    for (cl_event e : wait_list) waits_storage.push_back(wrap(e));
-    const std::vector<cl::Event>* waits = waits_storage.empty() ? nullptr : &waits_storage;
-    cl::Event done;
-    m.last_variant = v;
-    if (!v.needs_pass()) {
-      if (fb.color_out == fb.color_in) {
-        queue.enqueueMarkerWithWaitList(waits, &done);
-      } else {
-        queue.enqueueCopyBuffer(wrap(fb.color_in), wrap(fb.color_out), 0, 0, color_bytes, waits, &done);
-        ++m.stats.buffer_copies;
-      }
-      return share(done);
-    }
-    const detail::FogCoefficients<float> k = detail::fog_coefficients<float>(settings, v.mode);
-    const auto& c = camera.frustum_corners;
-    kernel->setArg(0, wrap(fb.color_in));
-    kernel->setArg(1, wrap(fb.depth));
-    kernel->setArg(2, wrap(fb.color_out));
-    kernel->setArg(3, cl_int(fb.width));
-    kernel->setArg(4, cl_int(fb.height));
-    kernel->setArg(5, f4(camera.zbuffer_params));
-    kernel->setArg(6, f4(camera.projection_params));
-    kernel->setArg(7, f4(c[kBottomLeft]));
-    kernel->setArg(8, f4(c[kBottomRight]));
-    kernel->setArg(9, f4(c[kTopLeft]));
-    kernel->setArg(10, f4(c[kTopRight]));
-    kernel->setArg(11, f4(k.a, k.b, 0.0f, 0.0f));
-    kernel->setArg(12, f4(settings.color.r, settings.color.g, settings.color.b, 0.0f));
-    const int per_item = pixels_per_work_item(m.traits);
-    queue.enqueueNDRangeKernel(*kernel, cl::NullRange,
-                               cl::NDRange((fb.width + per_item - 1) / per_item, fb.height),
-                               cl::NullRange, waits, &done);
-    ++m.stats.kernel_dispatches;
-    return share(done);
+    return m.dispatch(queue, fb, v, camera, settings, wait_list);
   });
+}
+
+cl_event FogPass::Impl::dispatch(const cl::CommandQueue& queue, const FrameBuffers& fb, const Variant& v,
+                                 const CameraParams& camera, const FogSettings& settings,
+                                 const std::vector<cl_event>& wait_list) {
+  cl::Kernel* kernel = v.needs_pass() ? find_kernel(v) : nullptr;
+  if (v.needs_pass() && kernel == nullptr)
+    throw Error("fog variant '" + describe(v) + "' is not prepared: call FogPass::prepare(settings, camera, " +
+                to_string(fb.format) + ") (or prepare(variant)) before enqueue, which never builds a program");
+  std::vector<cl::Event> waits_storage;
+  for (cl_event e : wait_list) waits_storage.push_back(wrap(e));
+  const std::vector<cl::Event>* waits = waits_storage.empty() ? nullptr : &waits_storage;
+  cl::Event done;
+  last_variant = v;
+  if (!v.needs_pass()) {
+    if (fb.color_out == fb.color_in) {
+      queue.enqueueMarkerWithWaitList(waits, &done);
+    } else {
+      queue.enqueueCopyBuffer(wrap(fb.color_in), wrap(fb.color_out), 0, 0,
+                              color_buffer_bytes(fb.width, fb.height, fb.format), waits, &done);
+      ++stats.buffer_copies;
+    }
+    return share(done);
+  }
+  const detail::FogCoefficients<float> k = detail::fog_coefficients<float>(settings, v.mode);
+  const auto& c = camera.frustum_corners;
+  kernel->setArg(0, wrap(fb.color_in));
+  kernel->setArg(1, wrap(fb.depth));
+  kernel->setArg(2, wrap(fb.color_out));
+  kernel->setArg(3, cl_int(fb.width));
+  kernel->setArg(4, cl_int(fb.height));
+  kernel->setArg(5, f4(camera.zbuffer_params));
+  kernel->setArg(6, f4(camera.projection_params));
+  kernel->setArg(7, f4(c[kBottomLeft]));
+  kernel->setArg(8, f4(c[kBottomRight]));
+  kernel->setArg(9, f4(c[kTopLeft]));
+  kernel->setArg(10, f4(c[kTopRight]));
+  kernel->setArg(11, f4(k.a, k.b, 0.0f, 0.0f));
+  kernel->setArg(12, f4(settings.color.r, settings.color.g, settings.color.b, 0.0f));
+  const int per_item = pixels_per_work_item(traits);
+  queue.enqueueNDRangeKernel(*kernel, cl::NullRange, cl::NDRange((fb.width + per_item - 1) / per_item, fb.height),
+                             cl::NullRange, waits, &done);
+  ++stats.kernel_dispatches;
+  return share(done);
 }
 
 void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
@@ -185,7 +195,9 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
     // CPU devices read and write the host images where they are (page-aligned storage);
     // other devices get copies.
     const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
-    const cl::Event done = adopt(enqueue(m.queue(), frame.raw, camera, settings));
+    // Input, camera and settings were checked above, the buffers are the frame's and the queue
+    // the pass's: no integration-API checks (their getInfo calls were 5-14 us a call).
+    const cl::Event done = adopt(m.dispatch(m.queue, frame.raw, v, camera, settings, {}));
     if (detail::read_back(m.queue, m.traits.cpu, frame, done, out))
       ++m.stats.zero_copy_frames;
     else
