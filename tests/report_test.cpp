@@ -24,28 +24,6 @@ constexpr double kFactorBudget = 2e-6;     // the library's budgets (tests/extre
 constexpr double kColorRelBudget = 1e-5;
 constexpr double kSmallestScale = 0.62;    // the report's fog color's smallest channel
 
-std::string fresh_dir(const std::string& name) {
-  const std::string d = temp_dir() + "/" + name + "-" + std::to_string(::getpid());
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::vector<std::vector<std::string>> read_csv(const std::string& path) {
-  std::ifstream f(path);
-  std::vector<std::vector<std::string>> rows;
-  std::string line;
-  while (std::getline(f, line)) {
-    std::vector<std::string> cells;
-    std::string cell;
-    std::istringstream s(line);
-    while (std::getline(s, cell, ',')) cells.push_back(cell);
-    if (!line.empty() && line.back() == ',') cells.push_back("");
-    rows.push_back(cells);
-  }
-  return rows;
-}
-
 bool matplotlib_available() { return std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0; }
 
 TEST(Report, WritesCsvJsonAndPlotWithSaneValues) {

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -67,6 +68,10 @@ ColorImage white_like(const ColorImage& like);
 // Size of one half-precision ulp at |x|.
 double half_ulp(double x);
 
+// An empty folder `name`-PID under temp_dir() (made anew).
+std::string fresh_dir(const std::string& name);
+// A CSV file's cells, row by row (a trailing comma is a last, empty cell).
+std::vector<std::vector<std::string>> read_csv(const std::string& path);
 std::string temp_dir();  // a per-run scratch folder: FOGCL_TEST_DIR, else the build tree's tests/tmp
 // The fogcl CLI under test: FOGCL_TEST_CLI, else the one this build made. Both variables exist
 // for runs outside the build tree (scripts/gpu-run.sh on the GPU machine).

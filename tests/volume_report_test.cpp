@@ -25,27 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string fresh_dir(const std::string& name) {
-  const std::string d = temp_dir() + "/" + name + "-" + std::to_string(::getpid());
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::vector<std::vector<std::string>> read_csv(const std::string& path) {
-  std::ifstream f(path);
-  std::vector<std::vector<std::string>> rows;
-  std::string line;
-  while (std::getline(f, line)) {
-    std::vector<std::string> cells;
-    std::string cell;
-    std::istringstream s(line);
-    while (std::getline(s, cell, ',')) cells.push_back(cell);
-    rows.push_back(cells);
-  }
-  return rows;
-}
-
 // Few variants: 2 step counts x (full, half depth-aware, half bilinear) x 2 integrators, buffer
 // noise, rgba32f, plus the Riemann rows on the dense scene.
 VolumeReportOptions small_report() {

@@ -29,16 +29,7 @@ std::atomic<std::size_t> g_measurements{0};
 using report_detail::one_line;
 using CacheKey = report_detail::DeviceKey;
 
-bool parse_precision(const std::string& s, Precision* p) {
-  for (Precision q : {Precision::precise, Precision::fast})
-    if (s == to_string(q)) return *p = q, true;
-  return false;
-}
-bool parse_storage(const std::string& s, ColorFormat* f) {
-  for (ColorFormat q : {ColorFormat::rgba32f, ColorFormat::rgba16f})
-    if (s == to_string(q)) return *f = q, true;
-  return false;
-}
+using report_detail::parse_named;
 
 struct Cached {
   std::string measured_on;
@@ -48,35 +39,19 @@ struct Cached {
 // Reads a cache file; false when missing, unreadable, for another key or malformed (then the
 // measurement is taken again and the file rewritten).
 bool read_cache(const std::string& path, const CacheKey& key, Cached* out) {
-  std::ifstream f(path);
-  if (!f) return false;
   std::map<std::string, std::string> meta;
-  std::string line;
-  bool table = false;
-  while (std::getline(f, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    if (!table) {
-      if (line == "precision,storage,max_abs_err_color,time_ms") {
-        table = true;
-        continue;
-      }
-      const std::size_t comma = line.find(',');
-      if (comma == std::string::npos) return false;
-      meta[line.substr(0, comma)] = line.substr(comma + 1);
-      continue;
-    }
-    std::istringstream row(line);
-    std::string p, s, e, t;
-    if (!std::getline(row, p, ',') || !std::getline(row, s, ',') || !std::getline(row, e, ',') ||
-        !std::getline(row, t))
-      return false;
+  std::vector<std::vector<std::string>> rows;
+  if (!report_detail::read_cache_table(path, "precision,storage,max_abs_err_color,time_ms", &meta, &rows)) return false;
+  for (const std::vector<std::string>& cells : rows) {
     VariantMeasurement m;
-    if (!parse_precision(p, &m.precision) || !parse_storage(s, &m.storage)) return false;
+    if (cells.size() != 4 || !parse_named(cells[0], {Precision::precise, Precision::fast}, &m.precision) ||
+        !parse_named(cells[1], {ColorFormat::rgba32f, ColorFormat::rgba16f}, &m.storage))
+      return false;
     char* end = nullptr;
-    m.max_abs_err_color = std::strtod(e.c_str(), &end);
-    if (end == e.c_str()) return false;
-    m.time_ms = std::strtod(t.c_str(), &end);
-    if (end == t.c_str()) return false;
+    m.max_abs_err_color = std::strtod(cells[2].c_str(), &end);
+    if (end == cells[2].c_str()) return false;
+    m.time_ms = std::strtod(cells[3].c_str(), &end);
+    if (end == cells[3].c_str()) return false;
     out->all.push_back(m);
   }
   if (meta["device"] != one_line(key.device) || meta["driver"] != one_line(key.driver) ||

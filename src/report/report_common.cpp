@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 
 #include "fogcl/error.h"
 #include "fogcl/version.h"
@@ -183,6 +184,33 @@ std::string short_num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.3g", v);
   return buf;
+}
+
+bool read_cache_table(const std::string& path, const std::string& header, std::map<std::string, std::string>* meta,
+                      std::vector<std::vector<std::string>>* rows) {
+  std::ifstream f(path);
+  if (!f) return false;
+  std::string line;
+  bool table = false;
+  while (std::getline(f, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (!table) {
+      if (line == header) {
+        table = true;
+        continue;
+      }
+      const std::size_t comma = line.find(',');
+      if (comma == std::string::npos) return false;
+      (*meta)[line.substr(0, comma)] = line.substr(comma + 1);
+      continue;
+    }
+    std::vector<std::string> cells;
+    std::istringstream row(line);
+    std::string cell;
+    while (std::getline(row, cell, ',')) cells.push_back(cell);
+    rows->push_back(cells);
+  }
+  return true;
 }
 
 }  // namespace fogcl::report_detail

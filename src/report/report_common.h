@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstddef>
+#include <initializer_list>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,19 @@
 #include "fogcl/runtime.h"
 
 namespace fogcl::report_detail {
+
+// A budget cache file: "key,value" lines, then the line `header`, then CSV rows; blank lines and
+// '#' comments are skipped. false when the file is missing or a meta line has no comma.
+bool read_cache_table(const std::string& path, const std::string& header, std::map<std::string, std::string>* meta,
+                      std::vector<std::vector<std::string>>* rows);
+
+// The one of `values` whose to_string() is `s` (a cache file's cell); false if none.
+template <class E>
+bool parse_named(const std::string& s, std::initializer_list<E> values, E* out) {
+  for (E v : values)
+    if (s == to_string(v)) return *out = v, true;
+  return false;
+}
 
 // 8-bit sRGB code: NaN -> 0, clamp to [0, 1], IEC 61966-2-1 encode, round; no dither.
 int srgb8(double linear);

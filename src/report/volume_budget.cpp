@@ -32,16 +32,7 @@ struct Cached {
   std::vector<VolumeVariantMeasurement> all;
 };
 
-bool parse_upsampling(const std::string& s, VolumeUpsampling* u) {
-  for (VolumeUpsampling q : {VolumeUpsampling::depth_aware, VolumeUpsampling::bilinear})
-    if (s == to_string(q)) return *u = q, true;
-  return false;
-}
-bool parse_noise(const std::string& s, NoiseSampling* n) {
-  for (NoiseSampling q : {NoiseSampling::buffer, NoiseSampling::image})
-    if (s == to_string(q)) return *n = q, true;
-  return false;
-}
+using report_detail::parse_named;
 bool parse_number(const std::string& s, double* v) {
   char* end = nullptr;
   *v = std::strtod(s.c_str(), &end);
@@ -60,32 +51,16 @@ std::map<std::string, std::string> cache_meta(const report_detail::DeviceKey& ke
 
 // false when missing, unreadable, for another key or malformed (then it is measured again).
 bool read_cache(const std::string& path, const std::map<std::string, std::string>& expect, Cached* out) {
-  std::ifstream f(path);
-  if (!f) return false;
   std::map<std::string, std::string> meta;
-  std::string line;
-  bool table = false;
-  while (std::getline(f, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    if (!table) {
-      if (line == kHeader) {
-        table = true;
-        continue;
-      }
-      const std::size_t comma = line.find(',');
-      if (comma == std::string::npos) return false;
-      meta[line.substr(0, comma)] = line.substr(comma + 1);
-      continue;
-    }
-    std::vector<std::string> cells;
-    std::istringstream row(line);
-    std::string cell;
-    while (std::getline(row, cell, ',')) cells.push_back(cell);
+  std::vector<std::vector<std::string>> rows;
+  if (!report_detail::read_cache_table(path, kHeader, &meta, &rows)) return false;
+  for (const std::vector<std::string>& cells : rows) {
     if (cells.size() != 6) return false;
     VolumeVariantMeasurement m;
     double steps = 0, divisor = 0;
     if (!parse_number(cells[0], &steps) || !parse_number(cells[1], &divisor) ||
-        !parse_upsampling(cells[2], &m.upsampling) || !parse_noise(cells[3], &m.noise) ||
+        !parse_named(cells[2], {VolumeUpsampling::depth_aware, VolumeUpsampling::bilinear}, &m.upsampling) ||
+        !parse_named(cells[3], {NoiseSampling::buffer, NoiseSampling::image}, &m.noise) ||
         !parse_number(cells[4], &m.max_abs_err) || !parse_number(cells[5], &m.time_ms))
       return false;
     m.steps = int(steps);
