@@ -78,9 +78,10 @@ for ax, (dist, f16) in zip(axes.flat, [("0", "0"), ("1", "0"), ("0", "1"), ("1",
     ax.set_title(f"exp2 fog, {'distance' if dist == '1' else 'depth'}-based, {'RGBA16F' if f16 == '1' else 'RGBA32F'}")
     ax.set_ylabel("GB/s moved (color in + out, depth in)")
     ax.set_yscale("log")
-axes.flat[0].legend(fontsize=8, loc="lower right")
+handles, labels = axes.flat[0].get_legend_handles_labels()
+fig.legend(handles, labels, fontsize=9, loc="lower center", ncol=4)  # below the panels: no bar hidden
 fig.suptitle("fogcl throughput per path (higher is better); dashed: 2-thread memcpy of the same bytes")
-fig.tight_layout()
+fig.tight_layout(rect=(0, 0.07, 1, 1))
 fig.savefig(out / "throughput.png", dpi=110)
 
 # Table: per resolution / mode / metric / storage: ms and ratio to memcpy2 for each path.
