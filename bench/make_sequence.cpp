@@ -16,18 +16,19 @@
 
 #include "fogcl/demo_scene.h"
 
+#include "fogcl/error.h"
+#include "fogcl/exr_io.h"
+
 namespace {
 
+// fogcl's own list of OpenEXR compression names (the CLI's --compression).
 bool compression_of(const std::string& name, Imf::Compression* c) {
-  static const struct {
-    const char* name;
-    Imf::Compression c;
-  } names[] = {{"none", Imf::NO_COMPRESSION}, {"rle", Imf::RLE_COMPRESSION},   {"zips", Imf::ZIPS_COMPRESSION},
-               {"zip", Imf::ZIP_COMPRESSION},  {"piz", Imf::PIZ_COMPRESSION},   {"pxr24", Imf::PXR24_COMPRESSION},
-               {"b44", Imf::B44_COMPRESSION},  {"dwaa", Imf::DWAA_COMPRESSION}, {"dwab", Imf::DWAB_COMPRESSION}};
-  for (const auto& n : names)
-    if (name == n.name) return *c = n.c, true;
-  return false;
+  try {
+    *c = Imf::Compression(fogcl::parse_exr_compression(name));
+    return true;
+  } catch (const fogcl::Error&) {
+    return false;
+  }
 }
 
 std::string frame_name(const std::string& dir, const char* stem, int frame) {
