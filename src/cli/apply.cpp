@@ -249,13 +249,11 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
                  o.compression.empty() ? (std::string(exr_compression_name(color.compression)) + " (the input's)").c_str()
                                        : o.compression.c_str());
   }
-  if (volumes != nullptr) {  // docs/DESIGN.md §5: the volumes first, the deferred fog on their result
-    ColorImage with_volumes;
-    volumes->apply(color.color, job.depth, with_volumes, params, sequence_frame, print_setup);
-    backend.apply(with_volumes, job.depth, job.out, params, settings);
-  } else {
-    backend.apply(color.color, job.depth, job.out, params, settings);
-  }
+  // docs/DESIGN.md §5: the volumes first, the deferred fog on their result. In place: the input's
+  // pixels are not needed again, and a sequence allocates no extra frame.
+  if (volumes != nullptr)
+    volumes->apply(job.color.color, job.depth, job.color.color, params, sequence_frame, print_setup);
+  backend.apply(color.color, job.depth, job.out, params, settings);
 }
 
 // The fogged frame's input pixels are not needed any more: memory stays bounded.
