@@ -26,12 +26,17 @@ inline float vol_jitter(std::uint32_t x, std::uint32_t y, std::uint32_t frame_in
 }
 
 /* The texture's texel (x, y, z) as four bytes 0..255 (docs/volumetric-noise.md: unorm8 RGBA,
- * x fastest). One aligned 4-byte load: vload4 on a uchar pointer may only assume byte alignment
- * (on the H100 the physical march at 1080p took 5.3 ms with it, 4.4 ms with this). Buffers are
- * allocated at least 4-byte aligned (CL_DEVICE_MEM_BASE_ADDR_ALIGN). */
+ * x fastest). VOL_TEXEL_WORD_LOADS (GPUs, volume_march_options): one aligned 4-byte load, since
+ * vload4 on a byte pointer may only assume byte alignment (the H100's physical march at 1080p:
+ * 5.3 ms with vload4, 4.4 ms with this). CPU devices keep vload4: on PoCL 3.1 the word load made
+ * the 1080p march 1.4x slower. Buffers are at least 4-byte aligned (CL_DEVICE_MEM_BASE_ADDR_ALIGN). */
 #ifdef __OPENCL_C_VERSION__
+#ifdef VOL_TEXEL_WORD_LOADS
 #define VOL_TEXEL(tex, n, x, y, z) \
   convert_float4(((VOL_GLOBAL const uchar4*)(tex))[((size_t)(z) * (n) + (y)) * (n) + (x)])
+#else
+#define VOL_TEXEL(tex, n, x, y, z) convert_float4(vload4(((size_t)(z) * (n) + (y)) * (n) + (x), (tex)))
+#endif
 #else
 #define VOL_TEXEL(tex, n, x, y, z) vol_texel<VOL_REAL>((tex), (n), (x), (y), (z))
 template <typename VOL_REAL>

@@ -336,6 +336,8 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
   o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.reversed_z) o += " -D REVERSED_Z";
   if (v.noise_sampling == NoiseSampling::image && (v.features & VOL_FEATURE_NOISE)) o += " -D VOL_NOISE_IMAGE";
+  if (v.noise_sampling == NoiseSampling::buffer && (v.features & VOL_FEATURE_NOISE) && !device.cpu)
+    o += " -D VOL_TEXEL_WORD_LOADS";  // kernels/volume_noise.h: GPUs only
   return o;
 }
 
