@@ -85,6 +85,25 @@ TEST(FramePipeline, WritesInOrderWithAFewFramesInFlight) {
   EXPECT_EQ(FakeJob::alive.load(), 0);
 }
 
+// The stage times --verbose prints: each stage's own work, not its waits, and the stages overlap.
+TEST(FramePipeline, ReportsEachStagesBusyTime) {
+  using std::chrono::milliseconds;
+  FramePipeline<FakeJob>::Stages s;
+  s.read = [](FakeJob&) { std::this_thread::sleep_for(milliseconds(10)); };
+  s.fog = [](FakeJob&) {};
+  s.write = [](FakeJob&) { std::this_thread::sleep_for(milliseconds(40)); };
+  s.done = [](const FakeJob&) { return true; };
+  const auto outcome = FramePipeline<FakeJob>::run(range(1, 10), s, nullptr);
+  std::printf("[   stages] read %.3f s, fog %.3f s, write %.3f s, wall %.3f s\n", outcome.read_s, outcome.fog_s,
+              outcome.write_s, outcome.total_s);
+  EXPECT_EQ(outcome.finished, 10);
+  EXPECT_GE(outcome.read_s, 0.100);
+  EXPECT_GE(outcome.write_s, 0.400);
+  EXPECT_LT(outcome.fog_s, 0.05);                               // never counts the fog thread's waits
+  EXPECT_LT(outcome.read_s, 0.300);                             // nor the reader's, behind a slow writer
+  EXPECT_LT(outcome.total_s, outcome.read_s + outcome.write_s);  // reading overlaps writing
+}
+
 TEST(FramePipeline, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
   FramePipeline<FakeJob>::Stages s;
   std::vector<int> fogged, written, reported;

@@ -432,9 +432,15 @@ int run_apply(const ApplyOptions& o) {
     for (const std::string& f : failures) std::fprintf(stderr, "  %s\n", f.c_str());
     return 1;
   }
-  if (o.verbose)
+  if (o.verbose) {
     std::fprintf(stderr, "fogged %zu frames, %zu program build(s)\n", frames.size(),
                  backend.is_scalar() ? std::size_t(0) : backend.pass()->programs().builds());
+    // Where the time went: the stages overlap, so the busiest one bounds the frame rate.
+    const double n = double(std::max(outcome.finished, 1));
+    std::fprintf(stderr, "stages per frame: read %.3f s, fog %.3f s, write %.3f s; wall %.3f s (%.2f frames/s)\n",
+                 outcome.read_s / n, outcome.fog_s / n, outcome.write_s / n, outcome.total_s / n,
+                 outcome.total_s > 0 ? double(outcome.finished) / outcome.total_s : 0.0);
+  }
   return 0;
 }
 

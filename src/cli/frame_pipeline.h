@@ -36,6 +36,9 @@ class FramePipeline {
   struct Outcome {
     int finished = 0;          // frames that reached done(), failed or not
     bool interrupted = false;  // *interrupt became non-zero before every frame finished
+    // Wall seconds each stage spent working (waits excluded) and the whole run: the busiest
+    // stage bounds the frame rate (--verbose prints them).
+    double read_s = 0, fog_s = 0, write_s = 0, total_s = 0;
   };
 
   // Runs `frames` through the stages. A non-zero *interrupt (set by a signal handler) stops it:
@@ -43,41 +46,48 @@ class FramePipeline {
   static Outcome run(const std::vector<int>& frames, const Stages& stages, const std::atomic<int>* interrupt) {
     FramePipeline p(interrupt);
     Outcome outcome;
+    const auto start = Clock::now();
+    double read_s = 0, fog_s = 0;  // each written by its stage's thread, read after the join
     std::thread reader, fogger;
     // Whatever way this function leaves, the stage threads are stopped and joined first.
     struct Joiner {
       FramePipeline& p;
       std::thread &a, &b;
-      ~Joiner() {
+      void join() {
         p.stop();
         if (a.joinable()) a.join();
         if (b.joinable()) b.join();
       }
+      ~Joiner() { join(); }
     } joiner{p, reader, fogger};
     reader = std::thread([&] {
       for (int frame : frames) {
         if (p.stopped()) break;
         auto job = std::make_unique<Job>();
         job->frame = frame;
-        p.guard(*job, stages.read);
+        read_s += timed(*job, stages.read);
         if (!p.read_to_fog_.push(std::move(job), p)) break;
       }
       p.read_to_fog_.close();
     });
     fogger = std::thread([&] {
       while (auto job = p.read_to_fog_.pop(p)) {
-        if ((*job)->error.empty()) p.guard(**job, stages.fog);
+        if ((*job)->error.empty()) fog_s += timed(**job, stages.fog);
         if (!p.fog_to_write_.push(std::move(*job), p)) break;
       }
       p.fog_to_write_.close();
     });
     while (auto job = p.fog_to_write_.pop(p)) {
       if (p.interrupted()) break;
-      if ((*job)->error.empty()) p.guard(**job, stages.write);
+      if ((*job)->error.empty()) outcome.write_s += timed(**job, stages.write);
       ++outcome.finished;
       if (!stages.done(**job)) break;
     }
     outcome.interrupted = p.interrupted() && outcome.finished < int(frames.size());
+    joiner.join();
+    outcome.read_s = read_s;
+    outcome.fog_s = fog_s;
+    outcome.total_s = std::chrono::duration<double>(Clock::now() - start).count();
     return outcome;
   }
 
@@ -90,6 +100,13 @@ class FramePipeline {
     stop_ = true;
     read_to_fog_.wake();
     fog_to_write_.wake();
+  }
+  using Clock = std::chrono::steady_clock;
+  // Runs the stage (guarded); returns its wall seconds.
+  static double timed(Job& job, const Stage& stage) {
+    const auto t = Clock::now();
+    guard(job, stage);
+    return std::chrono::duration<double>(Clock::now() - t).count();
   }
   static void guard(Job& job, const Stage& stage) {
     try {
