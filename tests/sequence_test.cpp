@@ -389,6 +389,26 @@ TEST_F(Sequence, BadOutputChoicesNameTheValueAndWriteNothing) {
   }
 }
 
+// The device opens while the first frame is read (apply.cpp, Devices): one that cannot open is
+// still one error for the run, never a failure per frame, and nothing is written.
+TEST_F(Sequence, ADeviceThatCannotOpenStopsTheRunWithOneError) {
+  make_frames(3, 16, 9);
+  for (const char* keep_going : {"", " --keep-going"}) {
+    const CliRun r = run_cli(inputs() + keep_going + " --device no-such-device-xyz --out " + path("out/o.####.exr"));
+    EXPECT_EQ(r.exit_code, 1) << keep_going << ": " << r.output;
+    EXPECT_NE(r.output.find("no OpenCL device matches 'no-such-device-xyz'"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("frame 2"), std::string::npos) << keep_going << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << keep_going << ": " << r.output;
+    EXPECT_TRUE(out_files().empty()) << keep_going;
+  }
+  // A single file: a bad input is named whether or not the device opens.
+  const CliRun r = run_cli("apply --color " + path("in/missing.exr") + " --depth " + path("in/depth.0001.exr") + kFog +
+                           " --device no-such-device-xyz --out " + path("out/one.exr"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("missing.exr"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("no OpenCL device"), std::string::npos) << r.output;
+}
+
 // ---- Killed runs -----------------------------------------------------------------------------------
 
 // The CLI started in the background, its output in `log`.

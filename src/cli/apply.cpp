@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <future>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -212,6 +213,19 @@ class Spares {
   std::vector<Frames> spares_;
 };
 
+// The device and the volume stage of a run. Opening a PoCL device loads its LLVM libraries:
+// 0.35 s a process on the 16-core machine (bench/results/device-16core-startup), a quarter of a
+// 12-frame 4K sequence at 16 threads. It opens on its own thread while the first frame is read.
+struct Devices {
+  Backend backend;
+  std::unique_ptr<VolumeStage> volumes;
+  explicit Devices(const ApplyOptions& o) : backend(o.device), volumes(VolumeStage::create(o.volumes, backend.runtime())) {}
+};
+
+std::future<std::unique_ptr<Devices>> open_devices(const ApplyOptions& o) {
+  return std::async(std::launch::async, [&o] { return std::make_unique<Devices>(o); });
+}
+
 // The passes of one frame (fog thread; the only user of the backend and the volume stage).
 // job.frame is the frame number, for passes that depend on it (sequence_frame: -1 for a single
 // file). job.out may hold a spare frame to fog into. volumes: null without --volumes.
@@ -347,10 +361,16 @@ int run_apply(const ApplyOptions& o) {
     if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
     FrameJob job;
     job.paths = {o.color_path, o.depth_path, o.out_path, o.png_path};
-    read_frame(o, job);  // a bad input is named before (and whether or not) a device opens
-    Backend backend(o.device);
-    const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
-    fog_frame(o, backend, job, o.verbose, volumes.get(), -1);
+    std::future<std::unique_ptr<Devices>> opening = open_devices(o);
+    try {
+      read_frame(o, job);
+    } catch (...) {
+      // A bad input is named whether or not the device opens.
+      try { opening.get(); } catch (...) {}
+      throw;
+    }
+    const std::unique_ptr<Devices> devices = opening.get();
+    fog_frame(o, devices->backend, job, o.verbose, devices->volumes.get(), -1);
     take_inputs(job);
     write_frame(o, job);
     return 0;
@@ -364,11 +384,15 @@ int run_apply(const ApplyOptions& o) {
   if (frames.empty()) throw Error("'" + o.color_path + "': no frames found (give --frames FIRST-LAST)");
 
   const int swept = sweep_stale_temporaries(out) + (o.png_path.empty() ? 0 : sweep_stale_temporaries(png));
-  Backend backend(o.device);  // one device, one context, one program cache for every frame
-  const std::unique_ptr<VolumeStage> volumes = VolumeStage::create(o.volumes, backend.runtime());
+  // One device, one context, one program cache for every frame; the fog stage takes it from
+  // `opening` at its first frame. A device that fails to open stops the run (not a frame failure).
+  std::future<std::unique_ptr<Devices>> opening = open_devices(o);
+  std::unique_ptr<Devices> devices;
+  std::string device_error;  // the fog thread writes it, done() reads it for any frame: guarded
+  std::mutex device_mutex;
   if (o.verbose) {
     std::fprintf(stderr, "threads: %d (OpenEXR (de)compression%s)\n", threads,
-                 backend.is_scalar() ? "" : "; PoCL's POCL_MAX_PTHREAD_COUNT unless set");
+                 resolve_device_choice(o.device) == "scalar" ? "" : "; PoCL's POCL_MAX_PTHREAD_COUNT unless set");
     const std::filesystem::path out_dir = std::filesystem::path(out.prefix + "x").parent_path();
     std::fprintf(stderr, "temporary files: %s\n",
                  detail::temporary_file_kind(out_dir.empty() ? "." : out_dir.string()).c_str());
@@ -391,8 +415,18 @@ int run_apply(const ApplyOptions& o) {
     read_frame(o, job, &spare);
   };
   stages.fog = [&](FrameJob& job) {
+    if (!devices) {
+      std::lock_guard<std::mutex> lock(device_mutex);
+      if (!device_error.empty()) throw Error(device_error);
+      try {
+        devices = opening.get();
+      } catch (const std::exception& e) {
+        device_error = e.what();
+        throw;
+      }
+    }
     job.out = spares.take();  // the passes reuse it when it has the frame's size and storage
-    fog_frame(o, backend, job, o.verbose && !setup_printed, volumes.get(), job.frame);
+    fog_frame(o, devices->backend, job, o.verbose && !setup_printed, devices->volumes.get(), job.frame);
     spare_inputs.give(take_inputs(job));
     setup_printed = true;
   };
@@ -401,6 +435,13 @@ int run_apply(const ApplyOptions& o) {
     spares.give(std::move(job.out));
   };
   stages.done = [&](const FrameJob& job) {
+    {
+      std::lock_guard<std::mutex> lock(device_mutex);
+      if (!device_error.empty()) {
+        stop_error = device_error;
+        return false;
+      }
+    }
     if (!job.error.empty()) {
       progress.clear();
       if (!o.keep_going) {
@@ -434,7 +475,7 @@ int run_apply(const ApplyOptions& o) {
   }
   if (o.verbose) {
     std::fprintf(stderr, "fogged %zu frames, %zu program build(s)\n", frames.size(),
-                 backend.is_scalar() ? std::size_t(0) : backend.pass()->programs().builds());
+                 !devices || devices->backend.is_scalar() ? std::size_t(0) : devices->backend.pass()->programs().builds());
     // Where the time went: the stages overlap, so the busiest one bounds the frame rate.
     const double n = double(std::max(outcome.finished, 1));
     std::fprintf(stderr, "stages per frame: read %.3f s, fog %.3f s, write %.3f s; wall %.3f s (%.2f frames/s)\n",
