@@ -10,7 +10,8 @@
 //                        found): one whole realize() per iteration, compiled before the loop
 //   BM_OpenCLDevice      the OpenCL pass, zero-copy buffers, device time from profiling events
 //   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish); on a
-//                        GPU the host round trip: upload + kernel + download
+//                        GPU the host round trip: upload + kernel + download. kernel_ms: its own
+//                        kernel's profiling time; call_vs_kernel: the call over it, same iterations
 //   BM_DeviceCopy        clEnqueueCopyBuffer of the pass's color and depth into device buffers
 //                        (profiling events): the device's own bandwidth ceiling, for GPUs
 //   BM_OpenCLDeviceCacheResident  BM_OpenCLDevice on a 512x256 frame that stays in the caches
@@ -379,9 +380,17 @@ void BM_OpenCLHostCall(benchmark::State& state) {
   Runtime* rt = runtime(state);
   if (rt == nullptr) return;
   FogPass& pass = shared_pass(*rt);
+  double kernel_ms = 0, call_ms = 0;
   timed_fog(state, "opencl-host", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
-    return host_time([&] { pass.apply(f.color, f.depth, out, f.params, s); });
+    const double call = host_time([&] { pass.apply(f.color, f.depth, out, f.params, s); });
+    kernel_ms += pass.stats().last_kernel_ms;
+    call_ms += call * 1e3;
+    return call;
   });
+  // The whole call against its own kernel in the same iterations: two benchmarks minutes apart
+  // see different machines (README, "Against Halide, and the host call").
+  state.counters["kernel_ms"] = kernel_ms / double(state.iterations());
+  state.counters["call_vs_kernel"] = kernel_ms > 0 ? call_ms / kernel_ms : 0.0;
 }
 
 // Where a convenience call's time goes on a CPU device: FogPass::apply's steps, each timed on the

@@ -1,6 +1,7 @@
 // The integration API (docs/DESIGN.md §1.1): the caller's context, queue and buffers as raw
 // handles; wait list in, owned event out; no hidden host synchronisation and no hidden build;
 // exact-size packed buffers (sub-buffers for regions); in place; fog off as a marker or a copy.
+#include <chrono>
 #include <cstring>
 #include <memory>
 
@@ -263,6 +264,24 @@ TEST_F(IntegrationApi, ConvenienceUsesHostMemoryOnCpuDevices) {
   ColorImage image = frame.color;
   pass.apply(image, frame.depth, image, frame.params, settings);
   EXPECT_EQ(std::memcmp(image.data(), out.data(), out.size_bytes()), 0);
+}
+
+// stats().last_kernel_ms: the kernel's own device time, inside the call's wall time, and 0 after a
+// call that ran no kernel (fog off: a copy).
+TEST_F(IntegrationApi, LastKernelTimeIsTheCallsKernel) {
+  FogPass pass(*runtime());
+  ColorImage out;
+  pass.apply(frame.color, frame.depth, out, frame.params, settings);  // the build, not timed below
+  const auto start = std::chrono::steady_clock::now();
+  pass.apply(frame.color, frame.depth, out, frame.params, settings);
+  const double call_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("[ kernel   ] %.3f ms of a %.3f ms call\n", pass.stats().last_kernel_ms, call_ms);
+  EXPECT_GT(pass.stats().last_kernel_ms, 0.0);
+  EXPECT_LE(pass.stats().last_kernel_ms, call_ms);
+  FogSettings off = settings;
+  off.mode = FogMode::off;
+  pass.apply(frame.color, frame.depth, out, frame.params, off);
+  EXPECT_EQ(pass.stats().last_kernel_ms, 0.0);
 }
 
 // apply() on images the caller keeps and changes between calls, as a renderer does every frame:

@@ -184,6 +184,7 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
   const bool in_place = &out == &in;
   if (!in_place && (out.width() != in.width() || out.height() != in.height() || out.format() != in.format()))
     out = ColorImage(in.width(), in.height(), in.format());
+  m.stats.last_kernel_ms = 0;
   if (!v.needs_pass()) {  // no device work at all
     m.last_variant = v;
     if (!in_place) std::memcpy(out.data(), in.data(), in.size_bytes());
@@ -202,6 +203,9 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
       ++m.stats.zero_copy_frames;
     else
       ++m.stats.copied_frames;
+    // `done` has completed (read_back waited for it): its timestamps are final.
+    m.stats.last_kernel_ms = double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                                    done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
   });
 }
 
