@@ -281,9 +281,13 @@ TEST_F(CliVolumes, ModeOffLeavesUnfoggedPixelsBitIdentical) {
   // The volumes behind the sphere and on the ground: the camera is outside both.
   const std::string json = kVolumesJson;
   write_text(in("outside.json"), "{\"volumes\": [" + json.substr(json.find("{\"center\": [3,")));
-  const ColorImage got =
-      run_ok(base_args({{"--volumes", in("outside.json")}}) + " --mode off --device scalar", "off.exr");
+  std::string output;
+  const ColorImage got = run_ok(base_args({{"--volumes", in("outside.json")}}) + " --mode off --device scalar --verbose",
+                                "off.exr", &output);
   ASSERT_GT(got.width(), 0);
+  EXPECT_NE(output.find("no deferred fog pass (fog off or density 0): the output is the volumes' result"),
+            std::string::npos) << output;
+  EXPECT_EQ(output.find("no pass runs"), std::string::npos) << output;
   VolumeScene s = scene();
   s.volumes.erase(s.volumes.begin());
   const VolumeResult<double> ref =

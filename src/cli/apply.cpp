@@ -263,7 +263,9 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
                                                                                 : "perspective",
                    to_string(variant.storage));
     else
-      std::fprintf(stderr, "  why: no pass runs (fog off or density 0): the output is the input\n");
+      std::fprintf(stderr, volumes != nullptr
+                               ? "  why: no deferred fog pass (fog off or density 0): the output is the volumes' result\n"
+                               : "  why: no pass runs (fog off or density 0): the output is the input\n");
     if (!backend.is_scalar() && variant.needs_pass())
       std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
     std::fprintf(stderr, "output: %s, compression %s\n", o.pixel_type.c_str(),
