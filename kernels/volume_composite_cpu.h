@@ -69,34 +69,24 @@ static inline float16 vol_depth_difference_v(float16 a, float16 b) {
   return select(d, (float16)0.0f, hi == lo);
 }
 
-/* One target row's window for a block: quad q's 4 columns of (P, A) from column b + 4q / s on, and
- * the depth keys of columns b .. b + 15. Where the window reaches past the row (the frame's first
- * and last blocks), it is gathered column by column with the edge clamp. */
-typedef struct {
-  float16 rgba[4];
-  float16 key;
-} VolWindow;
-
-static inline void vol_load_window(global const float* low, global const float* low_key, int row, int b,
-                                   int low_width, VolWindow* w) {
-  const size_t at = (size_t)row * (size_t)low_width;
-  if (b >= 0 && b + 15 < low_width) {
-    for (int q = 0; q < 4; ++q) w->rgba[q] = vload16(0, low + 4 * (at + (size_t)(b + 4 * q / VOL_SCALE)));
-#if VOL_DEPTH_AWARE
-    w->key = vload16(0, low_key + at + (size_t)b);
-#endif
-    return;
-  }
-  float cols[4 * 16];
-  float keys[16];
-  for (int c = 0; c < 16; ++c) {
-    const size_t i = at + (size_t)clamp(b + c, 0, low_width - 1);
-    vstore4(vload4(i, low), c, cols);
-    keys[c] = low_key[i];
-  }
-  for (int q = 0; q < 4; ++q) w->rgba[q] = vload16(0, cols + 4 * (4 * q / VOL_SCALE));
-  w->key = vload16(0, keys);
+/* A target row's window for a block, as values (no private arrays: PoCL gives those a copy per
+ * work-item of the work-group, past L1): 4 columns of (P, A) from column c, and the depth keys of
+ * columns b .. b + 15. Blocks whose window reaches past the row (the frame's first and last
+ * blocks) gather it column by column with the edge clamp. */
+#define VOL_COLUMN(c) vload4(0, low + 4 * (at + (size_t)clamp((c), 0, low_width - 1)))
+static inline float16 vol_window_rgba(global const float* low, size_t at, int c, int low_width, int inside) {
+  if (inside) return vload16(0, low + 4 * (at + (size_t)c));
+  return (float16)(VOL_COLUMN(c), VOL_COLUMN(c + 1), VOL_COLUMN(c + 2), VOL_COLUMN(c + 3));
 }
+#undef VOL_COLUMN
+#define VOL_KEY(c) low_key[at + (size_t)clamp(b + (c), 0, low_width - 1)]
+static inline float16 vol_window_keys(global const float* low_key, size_t at, int b, int low_width, int inside) {
+  if (inside) return vload16(0, low_key + at + (size_t)b);
+  return (float16)(VOL_KEY(0), VOL_KEY(1), VOL_KEY(2), VOL_KEY(3), VOL_KEY(4), VOL_KEY(5), VOL_KEY(6), VOL_KEY(7),
+                   VOL_KEY(8), VOL_KEY(9), VOL_KEY(10), VOL_KEY(11), VOL_KEY(12), VOL_KEY(13), VOL_KEY(14),
+                   VOL_KEY(15));
+}
+#undef VOL_KEY
 
 /* Quad q of the block as bits: the composite where 0 < A, the input's bits where A == 0 and in
  * the alpha lanes (vol_composite's rules; A == 1 writes P exactly). */
@@ -144,27 +134,31 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   const float fy = vol_upsample_axis(y, VOL_SCALE, (int)frame[VOL_F_LOW_HEIGHT], &y0, &y1);
   const float16 gx = (VOL_LANE_INDEX + 0.5f) / (float)VOL_SCALE - 0.5f;
   const float16 fx = gx - floor(gx);
-  const float16 bilinear[4] = {(1.0f - fx) * (1.0f - fy), fx * (1.0f - fy), (1.0f - fx) * fy, fx * fy};
-  VolWindow top, bottom;
   const int b = x0 / VOL_SCALE - 1;
-  vol_load_window(low, low_key, y0, b, low_width, &top);
-  vol_load_window(low, low_key, y1, b, low_width, &bottom);
-  float16 w[4] = {bilinear[0], bilinear[1], bilinear[2], bilinear[3]};
+  const int inside = b >= 0 && b + 15 < low_width; /* the keys' load reaches b + 15 */
+  const size_t top = (size_t)y0 * (size_t)low_width, bottom = (size_t)y1 * (size_t)low_width;
+  float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
 #if VOL_DEPTH_AWARE
   const float16 key = vol_eye_depth_v(vload16(0, depth + i0), frame[VOL_F_ZX], frame[VOL_F_ZY],
                                       frame[VOL_F_NEAR], frame[VOL_F_FAR]);
-  const float16 tap_key[4] = {shuffle(top.key, VOL_LEFT_TAP), shuffle(top.key, VOL_RIGHT_TAP),
-                              shuffle(bottom.key, VOL_LEFT_TAP), shuffle(bottom.key, VOL_RIGHT_TAP)};
-  for (int k = 0; k < 4; ++k) w[k] = w[k] / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, tap_key[k]));
+  const float16 top_keys = vol_window_keys(low_key, top, b, low_width, inside);
+  const float16 bottom_keys = vol_window_keys(low_key, bottom, b, low_width, inside);
+  w0 = w0 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(top_keys, VOL_LEFT_TAP)));
+  w1 = w1 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(top_keys, VOL_RIGHT_TAP)));
+  w2 = w2 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(bottom_keys, VOL_LEFT_TAP)));
+  w3 = w3 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(bottom_keys, VOL_RIGHT_TAP)));
 #endif
-  const float16 weight = 0.0f + w[0] + w[1] + w[2] + w[3];
-#define VOL_QUAD(q)                                                                                          \
-  {                                                                                                          \
-    const float16 sum = 0.0f + shuffle(top.rgba[q], VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w[0], q) +              \
-                        shuffle(top.rgba[q], VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w[1], q) +                    \
-                        shuffle(bottom.rgba[q], VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w[2], q) +                  \
-                        shuffle(bottom.rgba[q], VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w[3], q);                  \
-    vol_composite_quad(in, out, q, sum / VOL_QUAD_SPREAD(weight, q));                                        \
+  const float16 weight = 0.0f + w0 + w1 + w2 + w3;
+#define VOL_QUAD(q)                                                                                      \
+  {                                                                                                      \
+    const int c = b + 4 * q / VOL_SCALE;                                                                 \
+    const float16 t = vol_window_rgba(low, top, c, low_width, inside);                                   \
+    const float16 u = vol_window_rgba(low, bottom, c, low_width, inside);                                \
+    const float16 sum = 0.0f + shuffle(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q) +                      \
+                        shuffle(t, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w1, q) +                            \
+                        shuffle(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q) +                             \
+                        shuffle(u, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w3, q);                             \
+    vol_composite_quad(in, out, q, sum / VOL_QUAD_SPREAD(weight, q));                                    \
   }
   VOL_QUAD(0)
   VOL_QUAD(1)
