@@ -17,8 +17,11 @@
 //        8..256; full/half/quarter; 1..16 volumes): work = sum over target pixels of steps x the
 //        volumes the pixel's ray enters before the scene, ns_per_work = device time / work (flat
 //        if the cost grows as the work does; bench/plot_volume.py draws it)
-// BM_VolumeDevice also times a 2-thread memcpy of the frame's color and depth (memcpy2_ms) for
-// composite_vs_memcpy2 = composite time / that copy.
+//   BM_VolumeComposite/integrator/f16/bilinear   the upsample + composite of BM_VolumeDevice at
+//        1080p half resolution (noise buffer) in both storages (RGBA32F, RGBA16F) and both
+//        upsamplings (depth-aware, bilinear)
+// BM_VolumeDevice and BM_VolumeComposite also time a 2-thread memcpy of the frame's color (in its
+// storage) and depth (memcpy2_ms) for composite_vs_memcpy2 = composite time / that copy.
 // Widths: 480 (480x270: scalar and OpenCL in the same run) and 1920 (1080p, OpenCL only).
 #include <algorithm>
 #include <chrono>
@@ -100,12 +103,12 @@ double event_ms(const cl::Event& a, cl_profiling_info from, const cl::Event& b, 
 }
 
 // Median of 7 copies of the frame's color and depth with 2 threads [ms]: the composite's ceiling.
-double memcpy2_ms(const DemoFrame& f) {
-  std::vector<std::byte> color(f.color.size_bytes()), depth(f.depth.size_bytes());
+double memcpy2_ms(const ColorImage& in_color, const DepthImage& in_depth) {
+  std::vector<std::byte> color(in_color.size_bytes()), depth(in_depth.size_bytes());
   const auto part = [&](int t) {
     const std::size_t cb = color.size(), db = depth.size();
-    std::memcpy(color.data() + cb * t / 2, static_cast<const std::byte*>(f.color.data()) + cb * t / 2, cb / 2 + t * (cb % 2));
-    std::memcpy(depth.data() + db * t / 2, reinterpret_cast<const std::byte*>(f.depth.data()) + db * t / 2,
+    std::memcpy(color.data() + cb * t / 2, static_cast<const std::byte*>(in_color.data()) + cb * t / 2, cb / 2 + t * (cb % 2));
+    std::memcpy(depth.data() + db * t / 2, reinterpret_cast<const std::byte*>(in_depth.data()) + db * t / 2,
                 db / 2 + t * (db % 2));
   };
   std::vector<double> ms;
@@ -154,17 +157,29 @@ double march_work(const DemoFrame& f, const VolumeScene& s, const VolumeSettings
 
 // A prepared pass and the frame's buffers in device memory on a profiling queue, as a renderer
 // holds them; run() times one frame from profiling events.
+// The demo frame's color in `format` (half rounds to nearest even).
+ColorImage color_in(const DemoFrame& f, ColorFormat format) {
+  if (format == f.color.format()) return f.color;
+  ColorImage c(f.color.width(), f.color.height(), format);
+  for (int y = 0; y < c.height(); ++y)
+    for (int x = 0; x < c.width(); ++x) c.set_pixel(x, y, f.color.pixel(x, y));
+  return c;
+}
+
 struct DeviceFrame {
-  DeviceFrame(const DemoFrame& f, const VolumeScene& s, const VolumeSettings& st)
-      : frame(f), scene(s), settings(st), pass(runtime()), max_eye(max_eye_depth(f.depth, f.params)) {
-    pass.prepare(f.params, s, st, ColorFormat::rgba32f);
+  DeviceFrame(const DemoFrame& f, const VolumeScene& s, const VolumeSettings& st,
+              ColorFormat storage = ColorFormat::rgba32f)
+      : frame(f), scene(s), settings(st), pass(runtime()), max_eye(max_eye_depth(f.depth, f.params)),
+        input(color_in(f, storage)) {
+    pass.prepare(f.params, s, st, storage);
     const cl::Context ctx = wrap(runtime().context());
     queue = cl::CommandQueue(ctx, wrap(runtime().device()), CL_QUEUE_PROFILING_ENABLE);
-    color = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.color.size_bytes(), const_cast<void*>(f.color.data()));
+    color = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, input.size_bytes(), input.data());
     depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.depth.size_bytes(), const_cast<float*>(f.depth.data()));
-    out = cl::Buffer(ctx, CL_MEM_READ_WRITE, f.color.size_bytes());
+    out = cl::Buffer(ctx, CL_MEM_READ_WRITE, input.size_bytes());
     fb.width = f.color.width();
     fb.height = f.color.height();
+    fb.format = storage;
     fb.color_in = color();
     fb.depth = depth();
     fb.color_out = out();
@@ -190,6 +205,7 @@ struct DeviceFrame {
   VolumeSettings settings;
   VolumePass pass;
   float max_eye;
+  ColorImage input;
   cl::CommandQueue queue;
   cl::Buffer color, depth, out;
   FrameBuffers fb;
@@ -213,10 +229,32 @@ void BM_VolumeDevice(benchmark::State& state) {
   state.counters["march_ms"] = march_ms / n;
   state.counters["composite_ms"] = composite_ms / n;
   state.counters["steps_x_pixels_per_s"] = kSteps * low_pixels / (march_ms / n * 1e-3);
-  const double copy_ms = memcpy2_ms(f);
+  const double copy_ms = memcpy2_ms(f.color, f.depth);
   state.counters["memcpy2_ms"] = copy_ms;
   state.counters["composite_vs_memcpy2"] = composite_ms / n / copy_ms;
   if (width == 480) state.counters["max_err"] = max_abs_rgb_error(d.result(), reference(integrator, divisor));
+}
+
+void BM_VolumeComposite(benchmark::State& state) {
+  const auto integrator = VolumeIntegrator(state.range(0));
+  const ColorFormat storage = state.range(1) ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+  const DemoFrame& f = frame(1920);
+  VolumeSettings st = settings(integrator, 2, false);
+  st.upsampling = state.range(2) ? VolumeUpsampling::bilinear : VolumeUpsampling::depth_aware;
+  DeviceFrame d(f, scene(integrator), st, storage);
+  double march_ms = 0, composite_ms = 0;
+  for (auto _ : state) {
+    const auto [m, c] = d.run();
+    march_ms += m;
+    composite_ms += c;
+    state.SetIterationTime(c * 1e-3);
+  }
+  const double n = double(state.iterations());
+  state.counters["march_ms"] = march_ms / n;
+  state.counters["composite_ms"] = composite_ms / n;
+  const double copy_ms = memcpy2_ms(d.input, f.depth);
+  state.counters["memcpy2_ms"] = copy_ms;
+  state.counters["composite_vs_memcpy2"] = composite_ms / n / copy_ms;
 }
 
 void BM_VolumeHostCall(benchmark::State& state) {
@@ -332,6 +370,12 @@ BENCHMARK(BM_VolumeDevice)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
+BENCHMARK(BM_VolumeComposite)
+    ->ArgNames({"integrator", "f16", "bilinear"})
+    ->ArgsProduct({{0, 1}, {0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);  // each iteration marches the frame again (1-2 s)
 BENCHMARK(BM_VolumeHostCall)
     ->ArgNames({"integrator", "divisor", "noise_image", "width"})
     ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}, {1920}})

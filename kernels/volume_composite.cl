@@ -1,14 +1,25 @@
 /* volume_composite.cl — the target upsampled onto the frame and composited over it
- * (docs/volumetric.md §Resolution, upsampling, composite). One work-item per frame pixel.
+ * (docs/volumetric.md §Resolution, upsampling, composite).
  *
  * Variant switches (the host's volume_composite_options()):
  *   VOL_SCALE        resolution divisor s: 1, 2 or 4
  *   VOL_DEPTH_AWARE  1: bilinear x depth similarity; 0: bilinear (the seed's blit)
  *   FOG_PROJECTION, REVERSED_Z  as in volume_march.cl (the pixel's depth for the similarity)
  *   FOG_COLOR_HALF   RGBA half storage; else RGBA float
+ *   VOL_LANES        frame pixels per work-item: 16 on CPU devices (volume_composite_cpu.h: PoCL
+ *                    vectorises only across work-items, and this kernel's per-pixel branches
+ *                    keep it from doing so), 1 elsewhere (coalesced GPU accesses)
+ *   FOG_PORTABLE     CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
+ * Global size: (ceil(width / VOL_LANES), height).
  */
 #pragma OPENCL FP_CONTRACT OFF
 
+#ifndef VOL_LANES
+#define VOL_LANES 1
+#endif
+#if VOL_LANES == 16
+#define FOG_CLAMP_BY_SELECT /* as in deferred_fog.cl: LLVM keeps IEEE comparisons */
+#endif
 #define FOG_REAL float
 #define FOG_INT int
 #define FOG_AS_UINT as_uint
@@ -16,7 +27,7 @@
 #define FOG_TO_REAL convert_float
 #define FOG_AS_REAL as_float
 #define FOG_NAME(name) name
-#define FOG_EXP2 fog_exp2_poly
+#define FOG_EXP2 FOG_NAME(fog_exp2_poly)
 #include "fog_math.h"
 
 #ifdef REVERSED_Z
@@ -35,12 +46,10 @@
 #define COLOR_T float
 #endif
 
-kernel void volume_composite(global const COLOR_T* color_in, global const float* depth, global COLOR_T* color_out,
-                             global const float* frame, global const float* low, global const float* low_key) {
-  const int x = get_global_id(0), y = get_global_id(1);
-  const int width = (int)frame[VOL_F_WIDTH];
-  if (x >= width || y >= (int)frame[VOL_F_HEIGHT]) return;
-  const size_t i = (size_t)y * (size_t)width + (size_t)x;
+/* One frame pixel: the GPU path and the row tails of the CPU path. */
+static inline void vol_composite_pixel(global const COLOR_T* color_in, global const float* depth,
+                                       global COLOR_T* color_out, global const float* frame, global const float* low,
+                                       global const float* low_key, size_t i, int x, int y) {
   float key = 0.0f;
 #if VOL_DEPTH_AWARE && VOL_SCALE > 1
   key = vol_eye_depth(depth[i], FOG_PROJECTION, VOL_REVERSED_Z, frame[VOL_F_ZX], frame[VOL_F_ZY],
@@ -65,7 +74,43 @@ kernel void volume_composite(global const COLOR_T* color_in, global const float*
                             vol_composite(c.z, fog.z, fog.w), c.w);
 #ifdef FOG_COLOR_HALF
   vstore_half4_rte(o, i, color_out);
+  /* alpha keeps its bits (a half trip would quiet a signalling NaN) */
+  ((global ushort*)color_out)[4 * i + 3] = ((global const ushort*)color_in)[4 * i + 3];
 #else
   vstore4(o, i, color_out);
+#endif
+}
+
+#if VOL_LANES == 16
+#define FOG_REAL float16
+#define FOG_INT int16
+#define FOG_AS_UINT as_uint16
+#define FOG_TRUNC_INT convert_int16
+#define FOG_TO_REAL convert_float16
+#define FOG_AS_REAL as_float16
+#define FOG_NAME(name) name##_v
+#include "fog_math.h" /* the depth formulas lane-wise */
+#include "fog_cpu_avx512.h"
+#include "volume_composite_cpu.h"
+#endif
+
+kernel void volume_composite(global const COLOR_T* color_in, global const float* depth, global COLOR_T* color_out,
+                             global const float* frame, global const float* low, global const float* low_key) {
+  const int width = (int)frame[VOL_F_WIDTH];
+  const int y = get_global_id(1);
+  if (y >= (int)frame[VOL_F_HEIGHT]) return;
+  const size_t row = (size_t)y * (size_t)width;
+#if VOL_LANES == 16
+  const int x0 = get_global_id(0) * 16;
+  if (x0 + 16 <= width) {
+    vol_composite16(color_in, depth, color_out, frame, low, low_key, row + x0, x0, y);
+  } else {
+    for (int x = x0; x < width; ++x) vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, row + x, x, y);
+  }
+#elif VOL_LANES == 1
+  const int x = get_global_id(0);
+  if (x < width) vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, row + x, x, y);
+#else
+#error "VOL_LANES must be 1 or 16"
 #endif
 }

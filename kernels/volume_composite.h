@@ -15,25 +15,35 @@ VOL_FN VOL_REAL vol_depth_difference(VOL_REAL a, VOL_REAL b) {
   return (hi - lo) / hi;
 }
 
+/* Along one axis: the two target pixels around full-resolution coordinate x (their centres are
+ * block centres; edges clamp) in *i0, *i1, and the bilinear weight of *i1. At s = 2 and 4 the
+ * weight is never 0 or 1; every step is exact (powers of 2, small integers). */
+VOL_FN VOL_REAL vol_upsample_axis(int x, int scale, int low_size, int* i0, int* i1) {
+  const VOL_REAL g = ((VOL_REAL)x + (VOL_REAL)0.5f) / (VOL_REAL)scale - (VOL_REAL)0.5f;
+  const VOL_REAL f0 = floor(g);
+  *i0 = max((int)f0, 0);
+  *i1 = min((int)f0 + 1, low_size - 1);
+  return g - f0;
+}
+
 /* The target (P, A) at full-resolution pixel (x, y) of eye depth `key`: the 2 x 2 nearest target
- * pixels (their centres are block centres; edges clamp), bilinear, or bilinear x depth similarity
- * when depth_aware. Scale 1 returns the pixel's own sample unchanged. */
+ * pixels, bilinear, or bilinear x depth similarity when depth_aware. Scale 1 returns the pixel's
+ * own sample unchanged. */
 VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL key, VOL_GLOBAL const VOL_REAL* low, VOL_GLOBAL const VOL_REAL* low_key,
                            int low_width, int low_height, int scale, int depth_aware) {
-  const VOL_REAL s = (VOL_REAL)scale;
-  const VOL_REAL gx = ((VOL_REAL)x + (VOL_REAL)0.5f) / s - (VOL_REAL)0.5f;
-  const VOL_REAL gy = ((VOL_REAL)y + (VOL_REAL)0.5f) / s - (VOL_REAL)0.5f;
-  const VOL_REAL fx0 = floor(gx), fy0 = floor(gy);
-  const VOL_REAL fx = gx - fx0, fy = gy - fy0;
-  const int x0 = max((int)fx0, 0), y0 = max((int)fy0, 0);
-  const int x1 = min((int)fx0 + 1, low_width - 1), y1 = min((int)fy0 + 1, low_height - 1);
+  if (scale == 1) {
+    const size_t i = (size_t)y * (size_t)low_width + (size_t)x;
+    return VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3));
+  }
+  int x0, x1, y0, y1;
+  const VOL_REAL fx = VOL_T(vol_upsample_axis)(x, scale, low_width, &x0, &x1);
+  const VOL_REAL fy = VOL_T(vol_upsample_axis)(y, scale, low_height, &y0, &y1);
   const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
   const VOL_REAL bilinear[4] = {((VOL_REAL)1 - fx) * ((VOL_REAL)1 - fy), fx * ((VOL_REAL)1 - fy),
                                 ((VOL_REAL)1 - fx) * fy, fx * fy};
   VOL_V4 sum = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   VOL_REAL weight = 0;
   for (int k = 0; k < 4; ++k) {
-    if (bilinear[k] == (VOL_REAL)0) continue;
     const size_t i = (size_t)ys[k] * (size_t)low_width + (size_t)xs[k];
     VOL_REAL w = bilinear[k];
     if (depth_aware) w = w / ((VOL_REAL)VOL_UPSAMPLE_EPS + vol_depth_difference(key, (VOL_REAL)low_key[i]));

@@ -348,6 +348,8 @@ std::string volume_composite_options(const VolumeVariant& v, const DeviceTraits&
   o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.reversed_z) o += " -D REVERSED_Z";
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
+  o += " -D VOL_LANES=" + std::to_string(pixels_per_work_item(device));
+  if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }
 

@@ -218,8 +218,9 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     composite.setArg(4, low);
     composite.setArg(5, low_key);
     const std::vector<cl::Event> after{marched};
-    queue.enqueueNDRangeKernel(composite, cl::NullRange, cl::NDRange(fb.width, fb.height), cl::NullRange, &after,
-                               &done);
+    const std::size_t lanes = std::size_t(pixels_per_work_item(m.traits));  // frame pixels per work-item
+    queue.enqueueNDRangeKernel(composite, cl::NullRange, cl::NDRange((fb.width + lanes - 1) / lanes, fb.height),
+                               cl::NullRange, &after, &done);
     ++m.stats.composite_dispatches;
     return share(done);
   });

@@ -1,0 +1,174 @@
+/* volume_composite_cpu.h — the CPU devices' path of volume_composite.cl (VOL_LANES 16): 16 frame
+ * pixels of a row per work-item. Kernel-only (OpenCL C); included by volume_composite.cl after
+ * the float16 instance of fog_math.h (names _v) and fog_cpu_avx512.h; needs COLOR_T.
+ *
+ * Why: PoCL vectorises only across work-items, and the one-pixel kernel's branches (the A == 0
+ * pass-through, the sky tests, the edge clamps) keep it scalar: 11-14x a memcpy. Here every
+ * per-pixel decision is a select on lanes, so the pass is one straight run of SIMD code.
+ *
+ * Layouts. Weights are computed with one lane per pixel (float16 over the row's 16 pixels);
+ * colors and the target's (P, A) as quads, 4 pixels x RGBA per float16, as in fog_cpu_blocks.h.
+ * With x0 a multiple of 16 and s in {2, 4}, pixel j of the block samples the target columns
+ * b + L_j and b + L_j + 1, b = x0 / s - 1, L_j = (j + s / 2) / s (vol_upsample_axis' floor of
+ * (x + 0.5) / s - 0.5, clamps aside), and its bilinear fraction depends only on j % s: the lanes
+ * compute it with vol_upsample's operations, which are exact here, so every lane rounds like the
+ * one-pixel kernel and the C++ path (tests/volume_composite_test.cpp compares the bits). Quad q
+ * of the block needs the 4 target columns from b + 4q / s on: one float16 load per target row.
+ * Rows whose window reaches past the target's edges load it column by column, clamped. */
+
+#ifdef __clang__
+/* 16 words at 4-byte alignment, moved by one unaligned vector instruction (as in fog_cpu_blocks.h:
+ * PoCL splits vstore16). */
+typedef uint vol_v16u_u __attribute__((__vector_size__(64), aligned(4)));
+#define VOL_STORE16U(value, p) (*(global vol_v16u_u*)(p) = __builtin_bit_cast(vol_v16u_u, (value)))
+#else
+#define VOL_STORE16U(value, p) vstore16((value), 0, (p))
+#endif
+
+#define VOL_LANE_INDEX (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
+/* Shuffle masks must be literal constants to become one permute instruction. L_j, and within a
+ * quad's 4-column window the column of each pixel's left tap (its right tap is the next one). */
+#if VOL_SCALE == 2
+#define VOL_LEFT_TAP (uint16)(0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8)
+#define VOL_RIGHT_TAP (uint16)(1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9)
+#define VOL_QUAD_LEFT (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11)
+#define VOL_QUAD_RIGHT (uint16)(4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11, 12, 13, 14, 15)
+#elif VOL_SCALE == 4
+#define VOL_LEFT_TAP (uint16)(0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4)
+#define VOL_RIGHT_TAP (uint16)(1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5)
+#define VOL_QUAD_LEFT (uint16)(0, 1, 2, 3, 0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7)
+#define VOL_QUAD_RIGHT (uint16)(4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11)
+#endif
+/* Lanes 4q .. 4q + 3 of a per-pixel float16, each spread over its pixel's RGBA lanes. */
+#define VOL_QUAD_SPREAD(v, q)                                                                         \
+  shuffle((v), (uint16)(4 * q, 4 * q, 4 * q, 4 * q, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 2, \
+                        4 * q + 2, 4 * q + 2, 4 * q + 2, 4 * q + 3, 4 * q + 3, 4 * q + 3, 4 * q + 3))
+#define VOL_QUAD_ALPHA(v) shuffle((v), (uint16)(3, 3, 3, 3, 7, 7, 7, 7, 11, 11, 11, 11, 15, 15, 15, 15))
+#define VOL_ALPHA_LANES (int16)(0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1)
+
+/* vol_eye_depth (volume_ray.h) lane-wise: the same operations, selects for its branches. */
+static inline float16 vol_eye_depth_v(float16 raw, float zx, float zy, float near_plane, float far_plane) {
+  const float16 depth = fog_sanitize_depth_v(raw, VOL_REVERSED_Z);
+#if FOG_PROJECTION == FOG_PROJECTION_INFINITE_FAR
+  return select(fog_eye_depth_infinite_v(depth, (float16)near_plane), (float16)INFINITY, depth == 0.0f);
+#else
+#if FOG_PROJECTION == FOG_PROJECTION_ORTHOGRAPHIC
+  const float16 linear01 = fog_linear01_depth_ortho_v(depth, (float16)zx, (float16)zy);
+#else
+  const float16 linear01 = fog_linear01_depth_v(depth, (float16)zx, (float16)zy, VOL_REVERSED_Z);
+#endif
+  return select(linear01 * far_plane, (float16)INFINITY, fog_is_sky_v(linear01));
+#endif
+}
+
+/* vol_depth_difference (volume_composite.h) lane-wise: the same operations, selects for its
+ * branches (equal depths 0, sky against a surface 1). */
+static inline float16 vol_depth_difference_v(float16 a, float16 b) {
+  const float16 hi = fmax(a, b), lo = fmin(a, b);
+  const float16 d = select((hi - lo) / hi, (float16)1.0f, !(hi < INFINITY));
+  return select(d, (float16)0.0f, hi == lo);
+}
+
+/* A target row's window for a block, as values (no private arrays: PoCL gives those a copy per
+ * work-item of the work-group, past L1): 4 columns of (P, A) from column c, and the depth keys of
+ * columns b .. b + 15. Blocks whose window reaches past the row (the frame's first and last
+ * blocks) gather it column by column with the edge clamp. */
+#define VOL_COLUMN(c) vload4(0, low + 4 * (at + (size_t)clamp((c), 0, low_width - 1)))
+static inline float16 vol_window_rgba(global const float* low, size_t at, int c, int low_width, int inside) {
+  if (inside) return vload16(0, low + 4 * (at + (size_t)c));
+  return (float16)(VOL_COLUMN(c), VOL_COLUMN(c + 1), VOL_COLUMN(c + 2), VOL_COLUMN(c + 3));
+}
+#undef VOL_COLUMN
+#define VOL_KEY(c) low_key[at + (size_t)clamp(b + (c), 0, low_width - 1)]
+static inline float16 vol_window_keys(global const float* low_key, size_t at, int b, int low_width, int inside) {
+  if (inside) return vload16(0, low_key + at + (size_t)b);
+  return (float16)(VOL_KEY(0), VOL_KEY(1), VOL_KEY(2), VOL_KEY(3), VOL_KEY(4), VOL_KEY(5), VOL_KEY(6), VOL_KEY(7),
+                   VOL_KEY(8), VOL_KEY(9), VOL_KEY(10), VOL_KEY(11), VOL_KEY(12), VOL_KEY(13), VOL_KEY(14),
+                   VOL_KEY(15));
+}
+#undef VOL_KEY
+
+/* Quad q of the block as bits: the composite where 0 < A, the input's bits where A == 0 and in
+ * the alpha lanes (vol_composite's rules; A == 1 writes P exactly). */
+static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* out, uint q, float16 fog) {
+  const float16 a = VOL_QUAD_ALPHA(fog);
+  const int16 keep = (a == 0.0f) | VOL_ALPHA_LANES;
+#ifdef FOG_COLOR_HALF
+  const ushort16 bits = vload16(q, (global const ushort*)in);
+#ifdef FOG_AVX512
+  const float16 c = __builtin_bit_cast(float16, __builtin_ia32_vcvtph2ps512_mask(
+      __builtin_bit_cast(fog_v16h, bits), (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
+#else
+  const float16 c = vload_half16(q, in);
+#endif
+  const float16 o = select(fog + c * (1.0f - a), fog, a == 1.0f);
+#ifdef FOG_AVX512
+  const ushort16 rounded = __builtin_bit_cast(ushort16, __builtin_ia32_vcvtps2ph512_mask(
+      __builtin_bit_cast(fog_v16f, o), 0 /* round to nearest even */, (fog_v16h){}, (ushort)0xffff));
+#else
+  ushort staged[16]; /* vstore_half has no register form: round through private memory */
+  vstore_half16_rte(o, 0, (half*)staged);
+  const ushort16 rounded = vload16(0, staged);
+#endif
+  vstore16(select(rounded, bits, convert_short16(keep)), q, (global ushort*)out);
+#else
+  const uint16 bits = vload16(q, (global const uint*)in);
+  const float16 c = as_float16(bits);
+  const float16 o = select(fog + c * (1.0f - a), fog, a == 1.0f);
+  VOL_STORE16U(select(as_uint16(o), bits, keep), (global uint*)out + 16 * q);
+#endif
+}
+
+/* 16 pixels of row y from column x0 (a multiple of 16, x0 + 16 <= width), frame index i0. */
+static inline void vol_composite16(global const COLOR_T* color_in, global const float* depth,
+                                   global COLOR_T* color_out, global const float* frame, global const float* low,
+                                   global const float* low_key, size_t i0, int x0, int y) {
+  global const COLOR_T* in = color_in + 4 * i0;
+  global COLOR_T* out = color_out + 4 * i0;
+#if VOL_SCALE == 1
+  /* The target is the frame's own resolution: each pixel's own sample, unchanged. */
+  for (uint q = 0; q < 4; ++q) vol_composite_quad(in, out, q, vload16(q, low + 4 * i0));
+#else
+  const int low_width = (int)frame[VOL_F_LOW_WIDTH];
+  int y0, y1;
+  const float fy = vol_upsample_axis(y, VOL_SCALE, (int)frame[VOL_F_LOW_HEIGHT], &y0, &y1);
+  const float16 gx = (VOL_LANE_INDEX + 0.5f) / (float)VOL_SCALE - 0.5f;
+  const float16 fx = gx - floor(gx);
+  const int b = x0 / VOL_SCALE - 1;
+  const int inside = b >= 0 && b + 15 < low_width; /* the keys' load reaches b + 15 */
+  const size_t top = (size_t)y0 * (size_t)low_width, bottom = (size_t)y1 * (size_t)low_width;
+  float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
+#if VOL_DEPTH_AWARE
+  const float16 key = vol_eye_depth_v(vload16(0, depth + i0), frame[VOL_F_ZX], frame[VOL_F_ZY],
+                                      frame[VOL_F_NEAR], frame[VOL_F_FAR]);
+  const float16 top_keys = vol_window_keys(low_key, top, b, low_width, inside);
+  const float16 bottom_keys = vol_window_keys(low_key, bottom, b, low_width, inside);
+  w0 = w0 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(top_keys, VOL_LEFT_TAP)));
+  w1 = w1 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(top_keys, VOL_RIGHT_TAP)));
+  w2 = w2 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(bottom_keys, VOL_LEFT_TAP)));
+  w3 = w3 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(bottom_keys, VOL_RIGHT_TAP)));
+#endif
+  const float16 weight = 0.0f + w0 + w1 + w2 + w3;
+#define VOL_QUAD(q)                                                                                      \
+  {                                                                                                      \
+    const int c = b + 4 * q / VOL_SCALE;                                                                 \
+    const float16 t = vol_window_rgba(low, top, c, low_width, inside);                                   \
+    const float16 u = vol_window_rgba(low, bottom, c, low_width, inside);                                \
+    const float16 sum = 0.0f + shuffle(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q) +                      \
+                        shuffle(t, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w1, q) +                            \
+                        shuffle(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q) +                             \
+                        shuffle(u, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w3, q);                             \
+    vol_composite_quad(in, out, q, sum / VOL_QUAD_SPREAD(weight, q));                                    \
+  }
+  VOL_QUAD(0)
+  VOL_QUAD(1)
+  VOL_QUAD(2)
+  VOL_QUAD(3)
+#undef VOL_QUAD
+#endif
+}
+
+#undef VOL_LANE_INDEX
+#undef VOL_QUAD_SPREAD
+#undef VOL_QUAD_ALPHA
+#undef VOL_ALPHA_LANES

@@ -1,0 +1,222 @@
+// The upsample + composite kernel (kernels/volume_composite.cl) on its own, against the C++ formulas
+// it compiles from (volume_formulas: vol_eye_depth, vol_upsample, vol_composite), bit for bit on
+// CPU devices: the 16-pixel path (with AVX-512 builtins and portable), its row tails, and the
+// one-pixel path GPUs run. Synthetic targets give every case its share: A == 0 (the color's bits
+// pass through, signalling NaNs included), A == 1 (P exactly, NaN/Inf colors hidden), partial A
+// over NaN/Inf colors, sky pixels and sky taps in depth-aware mode, NaN depths, the target's
+// edges (first and last blocks clamp), widths that are not a multiple of 16.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "runtime/clhpp.h"
+#include "test_support.h"
+#include "volume/volume_formulas.h"
+#include "volume/volume_params.h"
+#include "volume_composite_cl.h"
+
+namespace fogcl::test {
+namespace {
+
+enum class Path { lanes, lanes_portable, one_pixel };
+enum class View { conventional, reversed, infinite_far, orthographic };
+
+struct CompositeCase {
+  Path path;
+  int scale;
+  bool depth_aware;
+  ColorFormat storage;
+  View view;
+  int width;
+};
+
+std::string name_of(const testing::TestParamInfo<CompositeCase>& info) {
+  const CompositeCase& c = info.param;
+  const char* paths[] = {"lanes", "lanes_portable", "one_pixel"};
+  const char* views[] = {"conventional", "reversed", "infinite_far", "orthographic"};
+  return std::string(paths[int(c.path)]) + "_s" + std::to_string(c.scale) + (c.depth_aware ? "_aware" : "_bilinear") +
+         (c.storage == ColorFormat::rgba16f ? "_f16_" : "_f32_") + views[int(c.view)] + "_w" + std::to_string(c.width);
+}
+
+std::vector<CompositeCase> all_cases() {
+  std::vector<CompositeCase> cases;
+  for (Path p : {Path::lanes, Path::lanes_portable, Path::one_pixel})
+    for (int s : {1, 2, 4})
+      for (bool aware : {true, false})
+        for (ColorFormat f : {ColorFormat::rgba32f, ColorFormat::rgba16f}) cases.push_back({p, s, aware, f, View::conventional, 83});
+  for (View v : {View::reversed, View::infinite_far, View::orthographic})
+    for (Path p : {Path::lanes, Path::one_pixel}) cases.push_back({p, 2, true, ColorFormat::rgba32f, v, 83});
+  for (int s : {2, 4}) cases.push_back({Path::lanes, s, true, ColorFormat::rgba16f, View::conventional, 64});
+  cases.push_back({Path::lanes, 4, true, ColorFormat::rgba32f, View::conventional, 7});  // a tail only
+  return cases;
+}
+
+CameraParams camera_of(View view, int width, int height) {
+  if (view == View::orthographic) {
+    OrthographicCamera o;
+    o.aspect = float(width) / float(height);
+    return make_camera_params(o);
+  }
+  PerspectiveCamera p;
+  p.aspect = float(width) / float(height);
+  p.reversed_z = view != View::conventional;
+  p.infinite_far = view == View::infinite_far;
+  return make_camera_params(p);
+}
+
+class VolumeCompositeKernel : public testing::TestWithParam<CompositeCase> {
+ protected:
+  void SetUp() override {
+    FOGCL_REQUIRE_DEVICE();
+    if (!runtime()->is_cpu())
+      GTEST_SKIP() << "bit identity with the C++ path is the CPU device's (GPU divisions may round differently)";
+  }
+};
+
+TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
+  using namespace volume_formulas;
+  const CompositeCase& c = GetParam();
+  const int width = c.width, height = 8 * c.scale + 5, s = c.scale;
+  const int low_width = (width + s - 1) / s, low_height = (height + s - 1) / s;
+  const CameraParams cam = camera_of(c.view, width, height);
+  const bool reversed = cam.reversed_z;
+  std::mt19937 rng(11 + s);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+
+  // Depth: random raw values, every 7th pixel sky, every 29th NaN.
+  DepthImage depth(width, height);
+  for (int i = 0; i < width * height; ++i)
+    depth.data()[i] = i % 29 == 3 ? std::numeric_limits<float>::quiet_NaN()
+                      : i % 7 == 0 ? (reversed ? 0.0f : 1.0f)
+                                   : unit(rng);
+  // Color: random HDR, and NaN, Inf and signalling NaNs (alpha too) in a pattern.
+  ColorImage color(width, height, c.storage);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      glm::vec4 v(4.0f * unit(rng), 4.0f * unit(rng), 4.0f * unit(rng), unit(rng));
+      const int k = (x * 5 + y * 3) % 11;
+      if (k < 3) v[k] = (x + y) % 2 ? nan : ((x + y) % 4 ? inf : -inf);
+      color.set_pixel(x, y, v);
+      if (k == 4) {
+        const std::size_t i = 4 * (std::size_t(y) * width + x);
+        if (c.storage == ColorFormat::rgba16f) {
+          color.rgba16f()[i + 1] = 0x7d01;
+          color.rgba16f()[i + 3] = 0xfd02;
+        } else {
+          const std::uint32_t snan = 0x7fa00001u;
+          std::memcpy(&color.rgba32f()[i + 1], &snan, 4);
+          std::memcpy(&color.rgba32f()[i + 3], &snan, 4);
+        }
+      }
+    }
+  // Target: a band of A == 0 (whole blocks clear), a band of A == 1, partial A elsewhere with a
+  // sprinkle of 0 and 1; keys: the block's nearest eye depth (the march's), some sky.
+  const int projection = int(cam.projection);
+  const float zx = cam.zbuffer_params.x, zy = cam.zbuffer_params.y, near_plane = cam.near_plane(),
+              far_plane = cam.far_plane();
+  std::vector<float> low(4 * std::size_t(low_width) * low_height), low_key(std::size_t(low_width) * low_height);
+  for (int ly = 0; ly < low_height; ++ly)
+    for (int lx = 0; lx < low_width; ++lx) {
+      const std::size_t i = std::size_t(ly) * low_width + lx;
+      const int band = ly * 4 / low_height;  // 0..3 down the frame
+      float a = unit(rng);
+      if (band == 0 || (lx + ly) % 9 == 0) a = 0.0f;
+      if (band == 1 || (lx + ly) % 9 == 4) a = 1.0f;
+      for (int k = 0; k < 3; ++k) low[4 * i + k] = a * unit(rng);
+      low[4 * i + 3] = a;
+      low_key[i] = (lx * 3 + ly) % 13 == 0 ? inf
+                                           : vol_block_eye_depth<float>(depth.data(), lx, ly, s, width, height, projection,
+                                                                        reversed, zx, zy, near_plane, far_plane);
+    }
+  std::array<float, VOL_F_COUNT> frame{};
+  frame[VOL_F_WIDTH] = float(width);
+  frame[VOL_F_HEIGHT] = float(height);
+  frame[VOL_F_SCALE] = float(s);
+  frame[VOL_F_LOW_WIDTH] = float(low_width);
+  frame[VOL_F_LOW_HEIGHT] = float(low_height);
+  frame[VOL_F_ZX] = zx;
+  frame[VOL_F_ZY] = zy;
+  frame[VOL_F_NEAR] = near_plane;
+  frame[VOL_F_FAR] = far_plane;
+
+  // The kernel, built with the options the pass would use for such a device.
+  detail::VolumeVariant variant;
+  variant.scale = s;
+  variant.depth_aware = c.depth_aware;
+  variant.projection = cam.projection;
+  variant.reversed_z = reversed;
+  variant.storage = c.storage;
+  DeviceTraits traits;
+  traits.opencl_c_version = device_opencl_c_version(runtime()->device());
+  traits.cpu = c.path != Path::one_pixel;
+  traits.codegen.target_intrinsics = c.path == Path::lanes;
+  const std::string options = detail::volume_composite_options(variant, traits);
+  const cl::Context ctx = wrap(runtime()->context());
+  const cl::Device device = wrap(runtime()->device());
+  cl::Program program(ctx, std::string(volume_composite_cl));
+  ASSERT_EQ(program.build({device}, options.c_str()), CL_SUCCESS)
+      << options << "\n" << program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device);
+  cl::Kernel kernel(program, "volume_composite");
+  const auto buffer = [&](const void* p, std::size_t bytes) {
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(p));
+  };
+  const cl::Buffer in = buffer(color.data(), color.size_bytes()), d = buffer(depth.data(), depth.size_bytes());
+  const cl::Buffer f = buffer(frame.data(), sizeof(frame)), l = buffer(low.data(), low.size() * 4),
+                   k = buffer(low_key.data(), low_key.size() * 4);
+  const cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, color.size_bytes());
+  int arg = 0;
+  for (const cl::Buffer* b : {&in, &d, &out, &f, &l, &k}) kernel.setArg(arg++, *b);
+  const cl::CommandQueue queue(ctx, device);
+  const int lanes = pixels_per_work_item(traits);
+  ASSERT_EQ(queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange((width + lanes - 1) / lanes, height)),
+            CL_SUCCESS);
+  ColorImage got(width, height, c.storage);
+  queue.enqueueReadBuffer(out, CL_TRUE, 0, got.size_bytes(), got.data());
+
+  // The formulas: A == 0 and alpha keep the input's bits; else vol_composite, rounded to the storage.
+  ColorImage want = color;
+  std::size_t clear = 0, opaque = 0, partial = 0, wrong = 0;
+  const std::size_t bpp = bytes_per_pixel(c.storage);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const std::size_t i = std::size_t(y) * width + x;
+      const float key = c.depth_aware && s > 1 ? vol_eye_depth<float>(depth.data()[i], projection, reversed, zx, zy,
+                                                                       near_plane, far_plane)
+                                               : 0.0f;
+      const glm::vec4 fog = vol_upsample<float>(x, y, key, low.data(), low_key.data(), low_width, low_height, s,
+                                                c.depth_aware);
+      if (fog.w == 0.0f) {
+        ++clear;
+      } else {
+        fog.w == 1.0f ? ++opaque : ++partial;
+        const glm::vec4 in_px = color.pixel(x, y);
+        glm::vec4 o(0.0f);
+        for (int ch = 0; ch < 3; ++ch) o[ch] = vol_composite<float>(in_px[ch], fog[ch], fog.w);
+        want.set_pixel(x, y, o);
+        auto* alpha = static_cast<unsigned char*>(want.data()) + i * bpp + 3 * (bpp / 4);
+        std::memcpy(alpha, static_cast<const unsigned char*>(color.data()) + i * bpp + 3 * (bpp / 4), bpp / 4);
+      }
+      const bool same = std::memcmp(static_cast<const unsigned char*>(got.data()) + i * bpp,
+                                    static_cast<const unsigned char*>(want.data()) + i * bpp, bpp) == 0;
+      if (!same && wrong++ < 5) {
+        const glm::vec4 g = got.pixel(x, y), w = want.pixel(x, y);
+        std::printf("    (%d, %d) A %g: got (%g %g %g %g) want (%g %g %g %g)\n", x, y, fog.w, g.x, g.y, g.z, g.w, w.x,
+                    w.y, w.z, w.w);
+      }
+    }
+  std::printf("  %s: %zu clear, %zu opaque, %zu partial pixels, %zu differ (options: %s)\n",
+              name_of({GetParam(), 0}).c_str(), clear, opaque, partial, wrong, options.c_str());
+  EXPECT_GT(clear, std::size_t(width));
+  EXPECT_GT(opaque, std::size_t(width));
+  EXPECT_GT(partial, std::size_t(width));
+  EXPECT_EQ(wrong, 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, VolumeCompositeKernel, testing::ValuesIn(all_cases()), name_of);
+
+}  // namespace
+}  // namespace fogcl::test
