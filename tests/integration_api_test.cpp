@@ -282,6 +282,14 @@ TEST_F(IntegrationApi, LastKernelTimeIsTheCallsKernel) {
   off.mode = FogMode::off;
   pass.apply(frame.color, frame.depth, out, frame.params, off);
   EXPECT_EQ(pass.stats().last_kernel_ms, 0.0);
+  // The caller's queue without profiling (a Runtime from its handles): the call works, no figure.
+  const Runtime theirs(ctx(), device(), queue());
+  FogPass on_their_queue(theirs);
+  ColorImage out2;
+  on_their_queue.apply(frame.color, frame.depth, out2, frame.params, settings);
+  EXPECT_EQ(on_their_queue.stats().last_kernel_ms, 0.0);
+  pass.apply(frame.color, frame.depth, out, frame.params, settings);
+  EXPECT_EQ(std::memcmp(out2.data(), out.data(), out.size_bytes()), 0);
 }
 
 // apply() on images the caller keeps and changes between calls, as a renderer does every frame:

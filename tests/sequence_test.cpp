@@ -104,6 +104,33 @@ TEST(FramePipeline, ReportsEachStagesBusyTime) {
   EXPECT_LT(outcome.total_s, outcome.read_s + outcome.write_s);  // reading overlaps writing
 }
 
+// Stages::start: once, on the caller's thread, while the reader already reads, before any write
+// (apply.cpp opens the device there).
+TEST(FramePipeline, StartRunsOnceOnTheCallersThreadBeforeTheFirstWrite) {
+  FramePipeline<FakeJob>::Stages s;
+  std::atomic<int> reads{0}, starts{0}, writes_before_start{0};
+  int reads_during_start = 0;
+  std::atomic<bool> started{false};
+  std::thread::id start_thread;
+  s.read = [&](FakeJob&) { ++reads; };
+  s.fog = [](FakeJob&) {};
+  s.write = [&](FakeJob&) { writes_before_start += !started; };
+  s.done = [](const FakeJob&) { return true; };
+  s.start = [&] {
+    ++starts;
+    start_thread = std::this_thread::get_id();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    reads_during_start = reads.load();
+    started = true;
+  };
+  const auto outcome = FramePipeline<FakeJob>::run(range(1, 6), s, nullptr);
+  EXPECT_EQ(outcome.finished, 6);
+  EXPECT_EQ(starts.load(), 1);
+  EXPECT_EQ(start_thread, std::this_thread::get_id());
+  EXPECT_EQ(writes_before_start.load(), 0);
+  EXPECT_GE(reads_during_start, 1);  // the first read overlapped it
+}
+
 TEST(FramePipeline, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
   FramePipeline<FakeJob>::Stages s;
   std::vector<int> fogged, written, reported;

@@ -215,8 +215,10 @@ class Spares {
 };
 
 // The device and the volume stage of a run. Opening a PoCL device loads its LLVM libraries:
-// 0.35 s a process on the 16-core machine (bench/results/device-16core-startup), a quarter of a
-// 12-frame 4K sequence at 16 threads. It opens on its own thread while the first frame is read.
+// 0.2-0.35 s a process on the 16-core machine (bench/results/device-16core-startup), a quarter of
+// a 12-frame 4K sequence at 16 threads. So the first frame is read meanwhile. The device opens on
+// the main thread, which lives as long as the process: LLVM gives the thread that initialises it
+// an alternate signal stack of its own, which a thread's exit then fails to release (ASan aborts).
 struct Devices {
   Backend backend;
   std::unique_ptr<VolumeStage> volumes;
@@ -224,13 +226,16 @@ struct Devices {
   explicit Devices(const ApplyOptions& o) : backend(o.device), volumes(VolumeStage::create(o.volumes, backend.runtime())) {}
 };
 
-std::future<std::unique_ptr<Devices>> open_devices(const ApplyOptions& o) {
-  return std::async(std::launch::async, [&o] {
+// Opens the devices into `result` (its value, or the exception that stopped them).
+void open_devices(const ApplyOptions& o, std::promise<std::unique_ptr<Devices>>& result) {
+  try {
     const auto start = std::chrono::steady_clock::now();
     auto devices = std::make_unique<Devices>(o);
     devices->open_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return devices;
-  });
+    result.set_value(std::move(devices));
+  } catch (...) {
+    result.set_exception(std::current_exception());
+  }
 }
 
 // The passes of one frame (fog thread; the only user of the backend and the volume stage).
@@ -370,15 +375,11 @@ int run_apply(const ApplyOptions& o) {
     if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
     FrameJob job;
     job.paths = {o.color_path, o.depth_path, o.out_path, o.png_path};
-    std::future<std::unique_ptr<Devices>> opening = open_devices(o);
-    try {
-      read_frame(o, job);
-    } catch (...) {
-      // A bad input is named whether or not the device opens.
-      try { opening.get(); } catch (...) {}
-      throw;
-    }
-    const std::unique_ptr<Devices> devices = opening.get();
+    std::future<void> reading = std::async(std::launch::async, [&] { read_frame(o, job); });
+    std::promise<std::unique_ptr<Devices>> opened;
+    open_devices(o, opened);
+    reading.get();  // a bad input is named whether or not the device opened
+    const std::unique_ptr<Devices> devices = opened.get_future().get();
     fog_frame(o, devices->backend, job, o.verbose, devices->volumes.get(), -1);
     take_inputs(job);
     write_frame(o, job);
@@ -393,9 +394,11 @@ int run_apply(const ApplyOptions& o) {
   if (frames.empty()) throw Error("'" + o.color_path + "': no frames found (give --frames FIRST-LAST)");
 
   const int swept = sweep_stale_temporaries(out) + (o.png_path.empty() ? 0 : sweep_stale_temporaries(png));
-  // One device, one context, one program cache for every frame; the fog stage takes it from
-  // `opening` at its first frame. A device that fails to open stops the run (not a frame failure).
-  std::future<std::unique_ptr<Devices>> opening = open_devices(o);
+  // One device, one context, one program cache for every frame: opened by the pipeline's start
+  // (this thread), taken by the fog stage at its first frame. A device that fails to open stops
+  // the run (not a frame failure).
+  std::promise<std::unique_ptr<Devices>> opened;
+  std::future<std::unique_ptr<Devices>> opening = opened.get_future();
   std::unique_ptr<Devices> devices;
   std::string device_error;  // the fog thread writes it, done() reads it for any frame: guarded
   std::mutex device_mutex;
@@ -423,6 +426,7 @@ int run_apply(const ApplyOptions& o) {
     InputFrames spare = spare_inputs.take();
     read_frame(o, job, &spare);
   };
+  stages.start = [&] { open_devices(o, opened); };
   stages.fog = [&](FrameJob& job) {
     if (!devices) {
       std::lock_guard<std::mutex> lock(device_mutex);
@@ -438,7 +442,7 @@ int run_apply(const ApplyOptions& o) {
     const auto start = std::chrono::steady_clock::now();
     fog_frame(o, devices->backend, job, o.verbose && !setup_printed, devices->volumes.get(), job.frame);
     if (o.verbose && !setup_printed)
-      std::fprintf(stderr, "start-up: device opened in %.3f s (on its own thread, while frame %d was read); "
+      std::fprintf(stderr, "start-up: device opened in %.3f s (while frame %d was read); "
                    "frame %d's passes %.3f s (program builds included)\n", devices->open_s, job.frame, job.frame,
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     spare_inputs.give(take_inputs(job));

@@ -29,6 +29,9 @@ class FramePipeline {
     Stage read;   // reader thread: loads the frame's inputs
     Stage fog;    // fog thread: the passes (the device); skipped for a frame that failed to read
     Stage write;  // the caller's thread: writes the outputs; skipped for a failed frame
+    // The caller's thread, once, after the reader and fog threads have started and before the
+    // first write (may be empty): set-up that overlaps the first read. Must not throw.
+    std::function<void()> start;
     // The caller's thread, in frame order, after each frame: error "" or what failed. Returns
     // false to stop the run (frames not yet written are dropped).
     std::function<bool(const Job&)> done;
@@ -77,6 +80,7 @@ class FramePipeline {
       }
       p.fog_to_write_.close();
     });
+    if (stages.start) stages.start();
     while (auto job = p.fog_to_write_.pop(p)) {
       if (p.interrupted()) break;
       if ((*job)->error.empty()) outcome.write_s += timed(**job, stages.write);

@@ -203,9 +203,12 @@ void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
       ++m.stats.zero_copy_frames;
     else
       ++m.stats.copied_frames;
-    // `done` has completed (read_back waited for it): its timestamps are final.
-    m.stats.last_kernel_ms = double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                                    done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
+    // `done` has completed (read_back waited for it): its timestamps are final. A caller's queue
+    // (Runtime from handles) may have no profiling: then there are none, and the figure stays 0.
+    cl_ulong start = 0, end = 0;
+    if (clGetEventProfilingInfo(done(), CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr) == CL_SUCCESS &&
+        clGetEventProfilingInfo(done(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr) == CL_SUCCESS)
+      m.stats.last_kernel_ms = double(end - start) * 1e-6;
   });
 }
 

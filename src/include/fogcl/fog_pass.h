@@ -41,7 +41,8 @@ struct PassStats {
   std::size_t zero_copy_frames = 0;   // convenience frames run on host memory in place
   std::size_t copied_frames = 0;      // convenience frames copied to and from the device
   // The last convenience apply's fog kernel on the device, profiling START -> END [ms]; 0 when
-  // that call ran no kernel. Its host call over this is the call's overhead (BM_OpenCLHostCall).
+  // that call ran no kernel or its queue has no profiling (a Runtime made from the caller's
+  // queue). Its host call over this is the call's overhead (BM_OpenCLHostCall).
   double last_kernel_ms = 0;
 };
 
