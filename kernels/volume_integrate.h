@@ -14,11 +14,12 @@
 
 /* Henyey-Greenstein phase function, normalised over the sphere (1 / 4 pi when g = 0); cos_theta
  * between the ray and the direction toward the light (forward scattering peaks looking at it). */
-VOL_FN VOL_REAL vol_phase_hg(VOL_REAL cos_theta, VOL_REAL g) {
+VOL_FN VOL_REAL vol_phase_hg(VOL_REAL cos_theta, VOL_U g) {
   const VOL_REAL denom = (VOL_REAL)1 + g * g - (VOL_REAL)2 * g * cos_theta;
   return ((VOL_REAL)1 - g * g) / ((VOL_REAL)(4.0 * 3.14159265358979323846) * denom * sqrt(denom));
 }
 
+#ifndef VOL_LANE_INSTANCE /* the lanes kernel looks up each lane's shadow with this one */
 /* 1 where world point p is lit, 0 in shadow: p is projected by the world -> light clip matrix
  * (column-major) and compared with the map's nearest texel, with the bias toward lit. Points
  * outside the map, behind the light, or over a NaN texel are lit. */
@@ -40,44 +41,65 @@ VOL_FN VOL_REAL vol_shadow_lit(VOL_V3 p, VOL_GLOBAL const float* frame, VOL_GLOB
   return shadowed ? (VOL_REAL)0 : (VOL_REAL)1;
 }
 
+#endif /* VOL_LANE_INSTANCE */
+
 /* stylized: one volume as the seed's shader draws it, (rgb, alpha) before blending. [front,
  * back] is the ray's part inside the sphere, t_scene the occluder. The march covers
  * min((t_scene - front) * occluder_overshoot, thickness) in `steps` steps from a start offset of
  * -jitter * step * 0.1; the first sample whose noise exceeds 0.1 switches to steps of 0.2 * step
  * after going back 4 of them, and is itself skipped (the seed's adaptive stepping, never back to
- * full steps). Alpha is fog_color.a * saturate(saturate(accumulation / distance) * density). */
-VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_REAL back,
-                                  VOL_REAL t_scene, VOL_REAL jitter, VOL_GLOBAL const float* vol,
-                                  VOL_GLOBAL const float* frame, VOL_NOISE_PARAM, int noise_size,
-                                  VOL_GLOBAL const float* shadow_map, int steps, int features) {
+ * full steps). Alpha is fog_color.a * saturate(saturate(accumulation / distance) * density).
+ * Three parts, so the lanes kernel runs the first two on 16 rays at once: the reach, the steps,
+ * the shading. */
+VOL_FN VOL_REAL vol_stylized_reach(VOL_REAL front, VOL_REAL back, VOL_REAL t_scene, VOL_U overshoot) {
   const VOL_REAL thickness = back - front;
-  const VOL_REAL reach = t_scene < (VOL_REAL)INFINITY
-                             ? fmin((t_scene - front) * VOL_P(vol, VOL_V_OVERSHOOT), thickness)
-                             : thickness;
-  if (!(reach > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
-  const VOL_REAL step = reach / (VOL_REAL)steps, time = VOL_P(frame, VOL_F_TIME);
-  const int noisy = (features & VOL_FEATURE_NOISE) && VOL_P(vol, VOL_V_NOISE) != (VOL_REAL)0;
-  VOL_REAL marched = -jitter * step * (VOL_REAL)VOL_JITTER_SPAN, current = step;
-  VOL_REAL accumulation = 0, shadowed = 0;
-  int refined = !(features & VOL_FEATURE_ADAPTIVE);
+  return t_scene < (VOL_REAL)INFINITY ? fmin((t_scene - front) * overshoot, thickness) : thickness;
+}
+
+/* The steps over [front, front + reach]: the accumulated fog, the shadowed length and the
+ * distance marched. The adaptive switch is a per-lane select (the refining sample adds nothing),
+ * not a `continue`, so every lane runs the same `steps` iterations. */
+VOL_FN void vol_stylized_march(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_REAL reach, VOL_REAL jitter,
+                               VOL_GLOBAL const float* vol, VOL_GLOBAL const float* frame, VOL_NOISE_PARAM,
+                               int noise_size, VOL_GLOBAL const float* shadow_map, int steps, int features,
+                               VOL_REAL* accumulation, VOL_REAL* shadowed, VOL_REAL* marched) {
+  const VOL_REAL step = reach / (VOL_REAL)steps;
+  const VOL_U time = VOL_PU(frame, VOL_F_TIME);
+  const int noisy = (features & VOL_FEATURE_NOISE) && VOL_PU(vol, VOL_V_NOISE) != (VOL_U)0;
+  VOL_REAL m = -jitter * step * (VOL_REAL)VOL_JITTER_SPAN, current = step;
+  VOL_REAL acc = (VOL_REAL)0, shade = (VOL_REAL)0;
+  VOL_INT refined = !(features & VOL_FEATURE_ADAPTIVE);
   for (int i = 0; i < steps; ++i) {
-    marched += current;
-    const VOL_REAL t = front + marched;
-    const VOL_V3 p = origin + dir * t;
+    m += current;
+    const VOL_REAL t = front + m;
+    const VOL_V3 p = VOL_MAKE3(origin.x + dir.x * t, origin.y + dir.y * t, origin.z + dir.z * t);
     VOL_REAL fog = noisy ? vol_density_field(vol, p, time, noise, noise_size, features & VOL_FEATURE_DETAIL)
                          : (VOL_REAL)1;
-    if (!refined && fog > (VOL_REAL)VOL_ADAPTIVE_ONSET) {
-      current = step * (VOL_REAL)VOL_ADAPTIVE_FACTOR;
-      marched -= current * (VOL_REAL)VOL_ADAPTIVE_BACK;
-      refined = 1;
-      continue;
+    VOL_INT skip = 0;
+    if (features & VOL_FEATURE_ADAPTIVE) {
+      skip = !refined && fog > (VOL_REAL)VOL_ADAPTIVE_ONSET;
+      if (VOL_ANY(skip)) {
+        current = skip ? step * (VOL_REAL)VOL_ADAPTIVE_FACTOR : current;
+        m = skip ? m - current * (VOL_REAL)VOL_ADAPTIVE_BACK : m;
+        refined = refined || skip;
+      }
     }
     if (features & VOL_FEATURE_FADES) fog *= vol_fades(vol, p, t);
-    if (features & VOL_FEATURE_SHADOW)
-      shadowed += ((VOL_REAL)1 - vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)) * current;
-    accumulation += fog * current;
+    if (features & VOL_FEATURE_SHADOW) {
+      const VOL_REAL lit = vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED);
+      shade = skip ? shade : shade + ((VOL_REAL)1 - lit) * current;
+    }
+    acc = skip ? acc : acc + fog * current;
   }
-  if (!(marched > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  *accumulation = acc;
+  *shadowed = shade;
+  *marched = m;
+}
+
+#ifndef VOL_LANE_INSTANCE
+/* The colour and alpha of a marched volume (marched > 0) seen along dir. */
+VOL_FN VOL_V4 vol_stylized_shade(VOL_V3 dir, VOL_REAL accumulation, VOL_REAL shadowed, VOL_REAL marched,
+                                 VOL_GLOBAL const float* vol, VOL_GLOBAL const float* frame, int features) {
   /* The lobe toward the light bends colour and light (the seed's k). */
   const VOL_V3 light_dir = VOL_P3(frame, VOL_F_LIGHT_DIR), light = VOL_P3(frame, VOL_F_LIGHT_COLOR);
   const VOL_REAL k = vol_pow(vol_saturate(dot(dir, light_dir)), VOL_P(vol, VOL_V_DIR_FALLOFF));
@@ -97,6 +119,19 @@ VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL
                      VOL_MAKE3(fmax(lit.x, floor_light.x), fmax(lit.y, floor_light.y), fmax(lit.z, floor_light.z));
   const VOL_REAL alpha = fog_color.w * vol_saturate(vol_saturate(accumulation / marched) * VOL_P(vol, VOL_V_DENSITY));
   return VOL_MAKE4(rgb.x, rgb.y, rgb.z, alpha);
+}
+
+VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_REAL back,
+                                  VOL_REAL t_scene, VOL_REAL jitter, VOL_GLOBAL const float* vol,
+                                  VOL_GLOBAL const float* frame, VOL_NOISE_PARAM, int noise_size,
+                                  VOL_GLOBAL const float* shadow_map, int steps, int features) {
+  const VOL_REAL reach = vol_stylized_reach(front, back, t_scene, VOL_P(vol, VOL_V_OVERSHOOT));
+  if (!(reach > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  VOL_REAL accumulation, shadowed, marched;
+  vol_stylized_march(origin, dir, front, reach, jitter, vol, frame, noise, noise_size, shadow_map, steps, features,
+                     &accumulation, &shadowed, &marched);
+  if (!(marched > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  return vol_stylized_shade(dir, accumulation, shadowed, marched, vol, frame, features);
 }
 
 /* The extinction [1/world] and the albedo-weighted light of the volumes of `mask` at p, t:
@@ -206,12 +241,11 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
   return VOL_MAKE4(i_r, i_g, i_b, -expm1(-depth));
 }
 
-/* The target pixel (lx, ly): its ray, its occluder, the march of the chosen integrator. Returns
- * (P premultiplied RGB, coverage A) and the block's eye depth in *key for the upsampling. */
-VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
-                              VOL_GLOBAL const float* vols, int count, VOL_NOISE_PARAM, int noise_size,
-                              VOL_GLOBAL const float* shadow_map, VOL_UINT frame_index, int integrator, int steps,
-                              int features, int jitter, int projection, int reversed_z, VOL_REAL* key) {
+/* The target pixel (lx, ly) as the march sees it: its ray, the distance along it to the occluder,
+ * and the block's eye depth in *key for the upsampling. */
+VOL_FN void vol_pixel_view(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
+                           int projection, int reversed_z, VOL_V3* origin, VOL_V3* dir, VOL_REAL* t_scene,
+                           VOL_REAL* key) {
   const int scale = (int)VOL_P(frame, VOL_F_SCALE);
   const VOL_REAL near_plane = VOL_P(frame, VOL_F_NEAR);
   const VOL_REAL eye_depth = vol_block_eye_depth(depth_buffer, lx, ly, scale, (int)VOL_P(frame, VOL_F_WIDTH),
@@ -219,29 +253,44 @@ VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buff
                                                  VOL_P(frame, VOL_F_ZX), VOL_P(frame, VOL_F_ZY), near_plane,
                                                  VOL_P(frame, VOL_F_FAR));
   *key = eye_depth;
-  VOL_V3 origin, dir;
   VOL_REAL t_per_eye;
   const VOL_REAL block_centre = (VOL_REAL)scale * (VOL_REAL)0.5f;
-  vol_pixel_ray((VOL_REAL)(lx * scale) + block_centre, (VOL_REAL)(ly * scale) + block_centre, frame, projection, &origin, &dir,
-                &t_per_eye);
-  const VOL_REAL t_scene = vol_scene_distance(eye_depth, near_plane, t_per_eye);
+  vol_pixel_ray((VOL_REAL)(lx * scale) + block_centre, (VOL_REAL)(ly * scale) + block_centre, frame, projection, origin,
+                dir, &t_per_eye);
+  *t_scene = vol_scene_distance(eye_depth, near_plane, t_per_eye);
+}
+
+/* stylized: the volume's (rgb, alpha) c drawn over the target with the seed's blend (SrcAlpha,
+ * OneMinusSrcAlpha; One, OneMinusSrcAlpha): premultiplied colour and coverage. */
+VOL_FN VOL_V4 vol_over(VOL_V4 target, VOL_V4 c) {
+  const VOL_REAL keep = (VOL_REAL)1 - c.w;
+  return VOL_MAKE4(c.x * c.w + target.x * keep, c.y * c.w + target.y * keep, c.z * c.w + target.z * keep,
+                   c.w + target.w * keep);
+}
+
+/* The target pixel (lx, ly): its ray, its occluder, the march of the chosen integrator. Returns
+ * (P premultiplied RGB, coverage A) and the block's eye depth in *key for the upsampling. */
+VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
+                              VOL_GLOBAL const float* vols, int count, VOL_NOISE_PARAM, int noise_size,
+                              VOL_GLOBAL const float* shadow_map, VOL_UINT frame_index, int integrator, int steps,
+                              int features, int jitter, int projection, int reversed_z, VOL_REAL* key) {
+  VOL_V3 origin, dir;
+  VOL_REAL t_scene;
+  vol_pixel_view(lx, ly, depth_buffer, frame, projection, reversed_z, &origin, &dir, &t_scene, key);
   const float j = vol_jitter((VOL_UINT)lx, (VOL_UINT)ly, frame_index);
   if (integrator != VOL_STYLIZED)
     return vol_physical(origin, dir, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame, noise,
                         noise_size, shadow_map, steps, features, integrator == VOL_RIEMANN);
-  /* stylized: each volume drawn over the target in the order given, with the seed's blend
-   * (SrcAlpha, OneMinusSrcAlpha; One, OneMinusSrcAlpha): premultiplied colour and coverage. */
+  /* stylized: each volume drawn over the target in the order given. */
   VOL_V4 target = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   for (int i = 0; i < count; ++i) {
     VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
     VOL_REAL t0, t1;
     if (!vol_sphere_hit(origin, dir, VOL_P3(vol, VOL_V_CENTER), VOL_P(vol, VOL_V_RADIUS), &t0, &t1)) continue;
     if (!(t0 < t_scene)) continue;
-    const VOL_V4 c = vol_stylized_volume(origin, dir, t0, t1, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0, vol, frame,
-                                         noise, noise_size, shadow_map, steps, features);
-    const VOL_REAL keep = (VOL_REAL)1 - c.w;
-    target = VOL_MAKE4(c.x * c.w + target.x * keep, c.y * c.w + target.y * keep, c.z * c.w + target.z * keep,
-                       c.w + target.w * keep);
+    target = vol_over(target, vol_stylized_volume(origin, dir, t0, t1, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0, vol,
+                                                  frame, noise, noise_size, shadow_map, steps, features));
   }
   return target;
 }
+#endif /* VOL_LANE_INSTANCE */

@@ -11,6 +11,16 @@
  *   REVERSED_Z       depth 1 at near
  *   VOL_NOISE_IMAGE  the noise is a 3D image read with the sampler's linear filter; else a
  *                    buffer of unorm8 texels filtered by volume_noise.h
+ *   VOL_LANES        target pixels per work-item: 16 on CPU devices (noise as a buffer), else 1
+ *
+ * Why 16 pixels per work-item on CPUs (docs/volumetric.md §Lanes on CPU devices): PoCL vectorises
+ * only across work-items, and the march's per-ray loops and branches keep it out, so each core
+ * marched one ray at a time. With VOL_LANES 16 a work-item marches 16 adjacent target pixels of
+ * a row, one float16 lane each: the per-sample functions of the shared headers are compiled a
+ * second time on float16 (volume_common.h), every lane runs all `steps` iterations of each volume
+ * some lane enters, and lanes that do not enter it are masked. Setting up the rays and shading a
+ * marched volume stay per pixel (the scalar functions, in a loop over the lanes). GPUs keep one
+ * pixel per work-item. Global size: (ceil(ceil(W / s) / VOL_LANES), ceil(H / s)).
  */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -41,6 +51,11 @@ constant sampler_t vol_noise_sampler = CLK_NORMALIZED_COORDS_TRUE | CLK_ADDRESS_
 #include "volume_noise.h"
 #include "volume_integrate.h"
 
+#ifndef VOL_LANES
+#define VOL_LANES 1
+#endif
+
+#if VOL_LANES == 1
 kernel void volume_march(global const float* depth, global const float* frame, global const float* volumes,
                          int count, VOL_NOISE_PARAM, int noise_size, global const float* shadow_map,
                          uint frame_index, global float* low, global float* low_key) {
@@ -55,3 +70,162 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   vstore4(r, i, low);
   low_key[i] = key;
 }
+
+#elif VOL_LANES == 16
+#if defined(VOL_NOISE_IMAGE) || VOL_INTEGRATOR != VOL_STYLIZED
+#error "VOL_LANES 16 marches the stylized integrator with the noise as a buffer"
+#endif
+typedef struct { float16 x, y, z; } vol_float3x16;
+typedef struct { float16 x, y, z, w; } vol_float4x16;
+/* Functions, not compound literals: clang 15 (PoCL 3.1) crashes on a vector cast inside one. */
+static inline __attribute__((always_inline)) vol_float3x16 vol_make3_x16(float16 x, float16 y, float16 z) {
+  vol_float3x16 v;
+  v.x = x, v.y = y, v.z = z;
+  return v;
+}
+static inline __attribute__((always_inline)) vol_float4x16 vol_make4_x16(float16 x, float16 y, float16 z, float16 w) {
+  vol_float4x16 v;
+  v.x = x, v.y = y, v.z = z, v.w = w;
+  return v;
+}
+
+/* The four channels of a texel word (bytes R, G, B, A from the lowest) as reals 0..255. */
+static inline __attribute__((always_inline)) vol_float4x16 vol_channels_x16(uint16 v) {
+  return vol_make4_x16(convert_float16(v & 0xffu), convert_float16((v >> 8) & 0xffu),
+                       convert_float16((v >> 16) & 0xffu), convert_float16(v >> 24));
+}
+
+/* Texels (x0, y, z) and (x1, y, z) of each lane, interpolated along x by fx (VOL_TEXEL_ROW). A
+ * texel is one 4-byte word; both come from one 8-byte load at x0 (x1 = x0 + 1 but where x wraps,
+ * whose lanes load the second again), so the x86 gathers fetch 64 elements per sample instead of
+ * 128. The buffer is 4-byte aligned and one texel longer than the texture (volume_pass.cpp). */
+typedef ulong vol_ulong_a4 __attribute__((aligned(4)));
+static inline __attribute__((overloadable, always_inline)) vol_float4x16 vol_lerp4(vol_float4x16 a, vol_float4x16 b, float16 f);
+static inline __attribute__((always_inline)) vol_float4x16 vol_texel_row_x16(global const uchar* tex, int n, int16 x0, int16 x1, int16 y, int16 z,
+                                              float16 fx) {
+  const int16 row = (z * n + y) * n;
+  global const uint* words = (global const uint*)tex;
+  int at[16];
+  uint lo[16], hi[16];
+  vstore16(row + x0, 0, at);
+  for (int k = 0; k < 16; ++k) {
+    const ulong w = *(global const vol_ulong_a4*)(words + at[k]);
+    lo[k] = (uint)w;
+    hi[k] = (uint)(w >> 32);
+  }
+  uint16 second = vload16(0, hi);
+  const int16 wrapped = x1 != x0 + 1;
+  if (any(wrapped)) {
+    int far[16];
+    vstore16(row + x1, 0, far);
+    for (int k = 0; k < 16; ++k) hi[k] = words[far[k]];
+    second = wrapped ? vload16(0, hi) : second;
+  }
+  return vol_lerp4(vol_channels_x16(vload16(0, lo)), vol_channels_x16(second), fx);
+}
+
+/* Each lane's shadow-map lookup, by the scalar function. */
+static inline __attribute__((overloadable)) float16 vol_shadow_lit(vol_float3x16 p, global const float* frame,
+                                                                   global const float* shadow_map, int reversed_z) {
+  float x[16], y[16], z[16], lit[16];
+  vstore16(p.x, 0, x);
+  vstore16(p.y, 0, y);
+  vstore16(p.z, 0, z);
+  for (int k = 0; k < 16; ++k) lit[k] = vol_shadow_lit((float3)(x[k], y[k], z[k]), frame, shadow_map, reversed_z);
+  return vload16(0, lit);
+}
+
+/* The lanes instance of the per-sample functions (volume_common.h), inlined: LLVM otherwise
+ * keeps the trilinear sample a call that passes its structs of float16 through memory. */
+#define VOL_LANE_INSTANCE
+#undef VOL_FN
+#define VOL_FN static inline __attribute__((overloadable, always_inline))
+#undef VOL_REAL
+#undef VOL_V3
+#undef VOL_V4
+#undef VOL_MAKE3
+#undef VOL_MAKE4
+#undef VOL_INT
+#undef VOL_TO_INT
+#undef VOL_ANY
+#undef VOL_TEXEL
+#undef VOL_TEXEL_ROW
+#define VOL_REAL float16
+#define VOL_V3 vol_float3x16
+#define VOL_V4 vol_float4x16
+#define VOL_MAKE3 vol_make3_x16
+#define VOL_MAKE4 vol_make4_x16
+#define VOL_INT int16
+#define VOL_TO_INT(x) convert_int16(x)
+#define VOL_ANY(m) any(m)
+#define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) vol_texel_row_x16((tex), (n), (x0), (x1), (y), (z), (fx))
+#include "volume_noise.h"
+#include "volume_integrate.h"
+
+kernel void volume_march(global const float* depth, global const float* frame, global const float* volumes,
+                         int count, VOL_NOISE_PARAM, int noise_size, global const float* shadow_map,
+                         uint frame_index, global float* low, global float* low_key) {
+  const int lx0 = get_global_id(0) * 16, ly = get_global_id(1);
+  const int low_width = (int)frame[VOL_F_LOW_WIDTH];
+  if (lx0 >= low_width || ly >= (int)frame[VOL_F_LOW_HEIGHT]) return;
+  /* Per pixel: the ray, the occluder, the jitter. Lanes past the row's end repeat its last pixel
+   * and are not stored. */
+  float ox[16], oy[16], oz[16], dx[16], dy[16], dz[16], scene[16], jitter[16], key[16];
+  float4 target[16];
+  for (int k = 0; k < 16; ++k) {
+    const int lx = min(lx0 + k, low_width - 1);
+    float3 o, d;
+    vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, &o, &d, &scene[k], &key[k]);
+    ox[k] = o.x, oy[k] = o.y, oz[k] = o.z, dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
+    jitter[k] = VOL_JITTER ? vol_jitter((uint)lx, (uint)ly, frame_index) : 0.0f;
+    target[k] = (float4)(0.0f);
+  }
+  const vol_float3x16 origin = vol_make3_x16(vload16(0, ox), vload16(0, oy), vload16(0, oz));
+  const vol_float3x16 dir = vol_make3_x16(vload16(0, dx), vload16(0, dy), vload16(0, dz));
+  const float16 t_scene = vload16(0, scene), jitter16 = vload16(0, jitter);
+  for (int i = 0; i < count; ++i) {
+    global const float* vol = volumes + i * VOL_V_STRIDE;
+    /* The lanes whose ray enters the sphere before the occluder; the others march an empty
+     * stretch at the origin and are not shaded. */
+    float front[16], back[16];
+    int enters[16], any_enters = 0;
+    for (int k = 0; k < 16; ++k) {
+      float t0, t1;
+      const int hit = vol_sphere_hit((float3)(ox[k], oy[k], oz[k]), (float3)(dx[k], dy[k], dz[k]),
+                                     VOL_PU3(vol, VOL_V_CENTER), VOL_PU(vol, VOL_V_RADIUS), &t0, &t1) &&
+                      t0 < scene[k];
+      front[k] = hit ? t0 : 0.0f;
+      back[k] = hit ? t1 : 0.0f;
+      enters[k] = hit ? -1 : 0;
+      any_enters |= hit;
+    }
+    if (!any_enters) continue;
+    const float16 front16 = vload16(0, front);
+    float16 reach = vol_stylized_reach(front16, vload16(0, back), t_scene, VOL_PU(vol, VOL_V_OVERSHOOT));
+    const int16 active = vload16(0, enters) && reach > 0.0f;
+    if (!any(active)) continue;
+    reach = active ? reach : 0.0f;
+    float16 accumulation, shadowed, marched;
+    vol_stylized_march(origin, dir, front16, reach, jitter16, vol, frame, noise, noise_size, shadow_map, VOL_STEPS,
+                       VOL_FEATURES, &accumulation, &shadowed, &marched);
+    float acc[16], sh[16], m[16];
+    int shade[16];
+    vstore16(accumulation, 0, acc);
+    vstore16(shadowed, 0, sh);
+    vstore16(marched, 0, m);
+    vstore16(active && marched > 0.0f, 0, shade);
+    for (int k = 0; k < 16; ++k)
+      if (shade[k])
+        target[k] = vol_over(target[k], vol_stylized_shade((float3)(dx[k], dy[k], dz[k]), acc[k], sh[k], m[k], vol,
+                                                           frame, VOL_FEATURES));
+  }
+  const int lanes = min(16, low_width - lx0);
+  for (int k = 0; k < lanes; ++k) {
+    const size_t at = (size_t)ly * (size_t)low_width + (size_t)(lx0 + k);
+    vstore4(target[k], at, low);
+    low_key[at] = key[k];
+  }
+}
+#else
+#error "VOL_LANES must be 1 or 16"
+#endif

@@ -327,8 +327,16 @@ int integrator_code(VolumeIntegrator integrator) {
   throw Error("volume integrator " + std::to_string(int(integrator)) + " is not one of stylized, physical, riemann");
 }
 
+int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
+  // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
+  // work-items, which the march's loops prevent; the lanes instance has no image sampling.
+  const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
+  return device.cpu && buffer && v.integrator == VolumeIntegrator::stylized ? 16 : 1;
+}
+
 std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& device) {
   std::string o = cl_std_option(device);
+  if (const int lanes = volume_march_lanes(v, device); lanes > 1) o += " -D VOL_LANES=" + std::to_string(lanes);
   o += " -D VOL_INTEGRATOR=" + std::to_string(integrator_code(v.integrator));
   o += " -D VOL_STEPS=" + std::to_string(v.steps);
   o += " -D VOL_FEATURES=" + std::to_string(v.features);

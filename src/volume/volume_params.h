@@ -49,6 +49,9 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
 // VOL_STYLIZED, VOL_PHYSICAL or VOL_RIEMANN (kernels/volume_common.h): the march's integrator switch.
 int integrator_code(VolumeIntegrator integrator);
 
+// Target pixels per work-item of the march (VOL_LANES): 16 on CPU devices where the lanes
+// instance applies, else 1. The global size's x is ceil(low_width / lanes).
+int volume_march_lanes(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_march_options(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_composite_options(const VolumeVariant& variant, const DeviceTraits& device);
 
