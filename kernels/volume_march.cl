@@ -72,8 +72,8 @@ kernel void volume_march(global const float* depth, global const float* frame, g
 }
 
 #elif VOL_LANES == 16
-#if defined(VOL_NOISE_IMAGE) || VOL_INTEGRATOR != VOL_STYLIZED
-#error "VOL_LANES 16 marches the stylized integrator with the noise as a buffer"
+#ifdef VOL_NOISE_IMAGE
+#error "VOL_LANES 16 reads the noise as a buffer"
 #endif
 typedef struct { float16 x, y, z; } vol_float3x16;
 typedef struct { float16 x, y, z, w; } vol_float4x16;
@@ -150,6 +150,7 @@ static inline __attribute__((overloadable)) float16 vol_shadow_lit(vol_float3x16
 #undef VOL_ANY
 #undef VOL_TEXEL
 #undef VOL_TEXEL_ROW
+#undef VOL_UINT
 #define VOL_REAL float16
 #define VOL_V3 vol_float3x16
 #define VOL_V4 vol_float4x16
@@ -158,9 +159,30 @@ static inline __attribute__((overloadable)) float16 vol_shadow_lit(vol_float3x16
 #define VOL_INT int16
 #define VOL_TO_INT(x) convert_int16(x)
 #define VOL_ANY(m) any(m)
+#define VOL_UINT uint16
 #define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) vol_texel_row_x16((tex), (n), (x0), (x1), (y), (z), (fx))
 #include "volume_noise.h"
 #include "volume_integrate.h"
+
+#if VOL_INTEGRATOR != VOL_STYLIZED
+/* physical: lane k's next piece with volumes from a on (vol_physical's walk): its end *b, its
+ * volumes *mask and its segment count *n; 0 when the ray has none left. *pieces counts the pieces
+ * walked, as vol_physical's loop does. */
+static int vol_lane_next_piece(const float* t_in, const float* t_out, uint hit, int count, float covered, float* a,
+                               float* b, uint* mask, float* n, int* pieces) {
+  for (; *pieces < 2 * count; ++*pieces) {
+    *mask = vol_piece(t_in, t_out, hit, count, *a, b);
+    if (!(*b < INFINITY)) return 0;
+    if (*mask != 0u) {
+      *n = (float)vol_piece_segments(*b - *a, VOL_STEPS, covered);
+      ++*pieces;
+      return 1;
+    }
+    *a = *b;
+  }
+  return 0;
+}
+#endif
 
 kernel void volume_march(global const float* depth, global const float* frame, global const float* volumes,
                          int count, VOL_NOISE_PARAM, int noise_size, global const float* shadow_map,
@@ -177,12 +199,14 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     float3 o, d;
     vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, &o, &d, &scene[k], &key[k]);
     ox[k] = o.x, oy[k] = o.y, oz[k] = o.z, dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
-    jitter[k] = VOL_JITTER ? vol_jitter((uint)lx, (uint)ly, frame_index) : 0.0f;
+    const float j = vol_jitter((uint)lx, (uint)ly, frame_index);
+    jitter[k] = VOL_JITTER ? j : VOL_INTEGRATOR == VOL_STYLIZED ? 0.0f : 0.5f;
     target[k] = (float4)(0.0f);
   }
   const vol_float3x16 origin = vol_make3_x16(vload16(0, ox), vload16(0, oy), vload16(0, oz));
   const vol_float3x16 dir = vol_make3_x16(vload16(0, dx), vload16(0, dy), vload16(0, dz));
   const float16 t_scene = vload16(0, scene), jitter16 = vload16(0, jitter);
+#if VOL_INTEGRATOR == VOL_STYLIZED
   for (int i = 0; i < count; ++i) {
     global const float* vol = volumes + i * VOL_V_STRIDE;
     /* The lanes whose ray enters the sphere before the occluder; the others march an empty
@@ -219,6 +243,70 @@ kernel void volume_march(global const float* depth, global const float* frame, g
         target[k] = vol_over(target[k], vol_stylized_shade((float3)(dx[k], dy[k], dz[k]), acc[k], sh[k], m[k], vol,
                                                            frame, VOL_FEATURES));
   }
+#else
+  /* physical: each lane walks its ray's pieces and segments as vol_physical does; an iteration
+   * takes every live lane's next segment, so all lanes sample at once while their pieces differ.
+   * Lanes whose ray is done sample nothing (an empty mask) until the last one is. */
+  float t_in[16][VOL_MAX_VOLUMES], t_out[16][VOL_MAX_VOLUMES];
+  float a[16], b[16], covered[16], n[16], j[16], cos_theta[16];
+  uint hit[16], mask[16];
+  int live[16], pieces[16];
+  for (int k = 0; k < 16; ++k) {
+    const float3 o = (float3)(ox[k], oy[k], oz[k]), d = (float3)(dx[k], dy[k], dz[k]);
+    hit[k] = vol_physical_hits(o, d, scene[k], volumes, count, t_in[k], t_out[k], &a[k]);
+    cos_theta[k] = dot(d, VOL_PU3(frame, VOL_F_LIGHT_DIR));
+    covered[k] = hit[k] != 0u ? vol_covered(t_in[k], t_out[k], hit[k], count, a[k]) : 0.0f;
+    pieces[k] = 0;
+    j[k] = 0.0f;
+    live[k] = hit[k] != 0u &&
+              vol_lane_next_piece(t_in[k], t_out[k], hit[k], count, covered[k], &a[k], &b[k], &mask[k], &n[k], &pieces[k])
+                  ? -1 : 0;
+  }
+  const float16 cos16 = vload16(0, cos_theta);
+  float16 i_r = 0.0f, i_g = 0.0f, i_b = 0.0f, optical = 0.0f;
+  for (;;) {
+    const int16 alive = vload16(0, live);
+    if (!any(alive)) break;
+    const float16 pa = alive ? vload16(0, a) : 0.0f, pb = alive ? vload16(0, b) : 0.0f;
+    const float16 pn = alive ? vload16(0, n) : 1.0f, pj = vload16(0, j);
+    const float16 length = pb - pa;
+    const float16 s0 = vol_segment_start(pa, length, pj, pn);
+    const float16 s1 = pj + 1.0f == pn ? pb : vol_segment_start(pa, length, pj + 1.0f, pn);
+    const float16 seg = s1 - s0, t = s0 + jitter16 * seg;
+    const vol_float3x16 p = vol_make3_x16(origin.x + dir.x * t, origin.y + dir.y * t, origin.z + dir.z * t);
+    float16 lit = 1.0f;
+    if (VOL_FEATURES & VOL_FEATURE_SHADOW)
+      lit = vol_shadow_lit(p, frame, shadow_map, VOL_FEATURES & VOL_FEATURE_SHADOW_REVERSED);
+    vol_float3x16 source;
+    const uint16 volumes_here = alive ? vload16(0, mask) : (uint16)0u;
+    const float16 sigma_t = vol_physical_sample(p, t, cos16, lit, volumes_here, volumes, count, frame, noise,
+                                                noise_size, VOL_FEATURES, &source);
+    const int16 adds = sigma_t > 0.0f;
+    if (any(adds)) {
+      const float16 scatter = vol_segment_weight(sigma_t, seg, optical, VOL_INTEGRATOR == VOL_RIEMANN);
+      i_r = adds ? i_r + source.x * scatter : i_r;
+      i_g = adds ? i_g + source.y * scatter : i_g;
+      i_b = adds ? i_b + source.z * scatter : i_b;
+      optical = adds ? optical + sigma_t * seg : optical;
+    }
+    vstore16(pj + 1.0f, 0, j);
+    int ends[16];
+    vstore16(alive && pj + 1.0f == pn, 0, ends);
+    for (int k = 0; k < 16; ++k)
+      if (ends[k]) {
+        a[k] = b[k];
+        j[k] = 0.0f;
+        live[k] = vol_lane_next_piece(t_in[k], t_out[k], hit[k], count, covered[k], &a[k], &b[k], &mask[k], &n[k],
+                                      &pieces[k]) ? -1 : 0;
+      }
+  }
+  float r[16], g[16], bl[16], cov[16];
+  vstore16(i_r, 0, r);
+  vstore16(i_g, 0, g);
+  vstore16(i_b, 0, bl);
+  vstore16(-expm1(-optical), 0, cov);
+  for (int k = 0; k < 16; ++k) target[k] = (float4)(r[k], g[k], bl[k], cov[k]);
+#endif
   const int lanes = min(16, low_width - lx0);
   for (int k = 0; k < lanes; ++k) {
     const size_t at = (size_t)ly * (size_t)low_width + (size_t)(lx0 + k);

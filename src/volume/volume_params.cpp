@@ -331,7 +331,7 @@ int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
   // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
   // work-items, which the march's loops prevent; the lanes instance has no image sampling.
   const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
-  return device.cpu && buffer && v.integrator == VolumeIntegrator::stylized ? 16 : 1;
+  return device.cpu && buffer ? 16 : 1;
 }
 
 std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& device) {
