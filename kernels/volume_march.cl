@@ -108,6 +108,7 @@ static inline __attribute__((always_inline)) vol_float4x16 vol_texel_row_x16(glo
   int at[16];
   uint lo[16], hi[16];
   vstore16(row + x0, 0, at);
+#pragma clang loop vectorize_width(16)
   for (int k = 0; k < 16; ++k) {
     const ulong w = *(global const vol_ulong_a4*)(words + at[k]);
     lo[k] = (uint)w;
@@ -122,6 +123,25 @@ static inline __attribute__((always_inline)) vol_float4x16 vol_texel_row_x16(glo
     second = wrapped ? vload16(0, hi) : second;
   }
   return vol_lerp4(vol_channels_x16(vload16(0, lo)), vol_channels_x16(second), fx);
+}
+
+/* Slice z of each lane's cell in the R channel alone (VOL_TEXEL_PLANE_R): the buffer holds, after
+ * the texture's N^3 texel words and one word of slack, N^3 words of 2 x 2 blocks of R, the word of
+ * (x, y, z) bytes R(x, y), R(x + 1, y), R(x, y + 1), R(x + 1, y + 1) (wrapped; built by
+ * detail::noise_r_blocks). One 4-byte load per lane gives the slice's four texels. */
+static inline __attribute__((overloadable, always_inline)) float16 vol_lerp(float16 a, float16 b, float16 f);
+static inline __attribute__((always_inline)) float16 vol_texel_plane_r_x16(global const uchar* tex, int n, int16 x0,
+                                                                             int16 y0, int16 z, float16 fx,
+                                                                             float16 fy) {
+  global const uint* blocks = (global const uint*)tex + (size_t)n * (size_t)n * (size_t)n + 1;
+  int at[16];
+  uint w[16];
+  vstore16((z * n + y0) * n + x0, 0, at);
+#pragma clang loop vectorize_width(16)
+  for (int k = 0; k < 16; ++k) w[k] = blocks[at[k]];
+  const uint16 v = vload16(0, w);
+  return vol_lerp(vol_lerp(convert_float16(v & 0xffu), convert_float16((v >> 8) & 0xffu), fx),
+                  vol_lerp(convert_float16((v >> 16) & 0xffu), convert_float16(v >> 24), fx), fy);
 }
 
 /* Each lane's shadow-map lookup, by the scalar function. */
@@ -151,6 +171,7 @@ static inline __attribute__((overloadable)) float16 vol_shadow_lit(vol_float3x16
 #undef VOL_TEXEL
 #undef VOL_TEXEL_ROW
 #undef VOL_UINT
+#undef VOL_NOISE_R
 #define VOL_REAL float16
 #define VOL_V3 vol_float3x16
 #define VOL_V4 vol_float4x16
@@ -160,6 +181,7 @@ static inline __attribute__((overloadable)) float16 vol_shadow_lit(vol_float3x16
 #define VOL_TO_INT(x) convert_int16(x)
 #define VOL_ANY(m) any(m)
 #define VOL_UINT uint16
+#define VOL_TEXEL_PLANE_R(tex, n, x0, y0, z, fx, fy) vol_texel_plane_r_x16((tex), (n), (x0), (y0), (z), (fx), (fy))
 #define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) vol_texel_row_x16((tex), (n), (x0), (x1), (y), (z), (fx))
 #include "volume_noise.h"
 #include "volume_integrate.h"
@@ -290,8 +312,10 @@ kernel void volume_march(global const float* depth, global const float* frame, g
       optical = adds ? optical + sigma_t * seg : optical;
     }
     vstore16(pj + 1.0f, 0, j);
+    const int16 piece_ends = alive && pj + 1.0f == pn;
+    if (!any(piece_ends)) continue;
     int ends[16];
-    vstore16(alive && pj + 1.0f == pn, 0, ends);
+    vstore16(piece_ends, 0, ends);
     for (int k = 0; k < 16; ++k)
       if (ends[k]) {
         a[k] = b[k];

@@ -48,39 +48,72 @@ inline VOL_V4 vol_texel(const std::uint8_t* tex, int n, int x, int y, int z) {
 #endif
 #endif /* VOL_LANE_INSTANCE */
 
-/* a + (b - a) * f on each channel. */
+/* a + (b - a) * f, and the same on each channel. */
+VOL_FN VOL_REAL vol_lerp(VOL_REAL a, VOL_REAL b, VOL_REAL f) { return a + (b - a) * f; }
 VOL_FN VOL_V4 vol_lerp4(VOL_V4 a, VOL_V4 b, VOL_REAL f) {
-  return VOL_MAKE4(a.x + (b.x - a.x) * f, a.y + (b.y - a.y) * f, a.z + (b.z - a.z) * f, a.w + (b.w - a.w) * f);
+  return VOL_MAKE4(vol_lerp(a.x, b.x, f), vol_lerp(a.y, b.y, f), vol_lerp(a.z, b.z, f), vol_lerp(a.w, b.w, f));
 }
 
-/* Texels (x0, y, z) and (x1, y, z) interpolated along x by fx: the lanes instance loads both
- * at once. */
-#ifndef VOL_TEXEL_ROW
-#define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) vol_lerp4(VOL_TEXEL(tex, n, x0, y, z), VOL_TEXEL(tex, n, x1, y, z), (fx))
-#endif
-
-/* Trilinear sample with wrap-around at uvw (texel centres at (i + 0.5) / N), in [0, 1]: the
- * manual filter of the buffer variant, in the path's precision. uvw is first wrapped to [0, 1),
- * so far-away or late-in-time coordinates cost no integer overflow. */
-VOL_FN VOL_V4 vol_noise_trilinear(VOL_GLOBAL const VOL_BYTE* tex, int n, VOL_V3 uvw) {
+/* The trilinear cell at uvw (texel centres at (i + 0.5) / N): the texels around it, wrapped, and
+ * the weights *f. uvw is first wrapped to [0, 1), so far-away or late-in-time coordinates cost no
+ * integer overflow. */
+VOL_FN void vol_noise_cell(int n, VOL_V3 uvw, VOL_INT* x0, VOL_INT* x1, VOL_INT* y0, VOL_INT* y1, VOL_INT* z0,
+                           VOL_INT* z1, VOL_V3* f) {
   const VOL_U fn = (VOL_U)n;
   const VOL_REAL gx = (uvw.x - floor(uvw.x)) * fn - (VOL_REAL)0.5f;
   const VOL_REAL gy = (uvw.y - floor(uvw.y)) * fn - (VOL_REAL)0.5f;
   const VOL_REAL gz = (uvw.z - floor(uvw.z)) * fn - (VOL_REAL)0.5f;
   const VOL_REAL gx0 = floor(gx), gy0 = floor(gy), gz0 = floor(gz);
-  const VOL_REAL fx = gx - gx0, fy = gy - gy0, fz = gz - gz0;
+  *f = VOL_MAKE3(gx - gx0, gy - gy0, gz - gz0);
   const int mask = n - 1; /* n is a power of two */
-  const VOL_INT x0 = (VOL_TO_INT(gx0) + n) & mask, y0 = (VOL_TO_INT(gy0) + n) & mask, z0 = (VOL_TO_INT(gz0) + n) & mask;
-  const VOL_INT x1 = (x0 + 1) & mask, y1 = (y0 + 1) & mask, z1 = (z0 + 1) & mask;
-  const VOL_V4 c00 = VOL_TEXEL_ROW(tex, n, x0, x1, y0, z0, fx), c10 = VOL_TEXEL_ROW(tex, n, x0, x1, y1, z0, fx);
-  const VOL_V4 c01 = VOL_TEXEL_ROW(tex, n, x0, x1, y0, z1, fx), c11 = VOL_TEXEL_ROW(tex, n, x0, x1, y1, z1, fx);
-  const VOL_V4 c = vol_lerp4(vol_lerp4(c00, c10, fy), vol_lerp4(c01, c11, fy), fz);
+  *x0 = (VOL_TO_INT(gx0) + n) & mask;
+  *y0 = (VOL_TO_INT(gy0) + n) & mask;
+  *z0 = (VOL_TO_INT(gz0) + n) & mask;
+  *x1 = (*x0 + 1) & mask;
+  *y1 = (*y0 + 1) & mask;
+  *z1 = (*z0 + 1) & mask;
+}
+
+/* Slice z of the cell: texels (x0, y), (x1, y) interpolated along x by fx for y0 and y1, then
+ * along y by fy. The lanes instance loads each row's pair at once. */
+#ifndef VOL_TEXEL_ROW
+#define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) vol_lerp4(VOL_TEXEL(tex, n, x0, y, z), VOL_TEXEL(tex, n, x1, y, z), (fx))
+#endif
+#define VOL_TEXEL_PLANE(tex, n, x0, x1, y0, y1, z, fx, fy) \
+  vol_lerp4(VOL_TEXEL_ROW(tex, n, x0, x1, y0, z, fx), VOL_TEXEL_ROW(tex, n, x0, x1, y1, z, fx), (fy))
+
+/* Trilinear sample with wrap-around at uvw, in [0, 1]: the manual filter of the buffer variant,
+ * in the path's precision. */
+VOL_FN VOL_V4 vol_noise_trilinear(VOL_GLOBAL const VOL_BYTE* tex, int n, VOL_V3 uvw) {
+  VOL_INT x0, x1, y0, y1, z0, z1;
+  VOL_V3 f;
+  vol_noise_cell(n, uvw, &x0, &x1, &y0, &y1, &z0, &z1, &f);
+  const VOL_V4 c = vol_lerp4(VOL_TEXEL_PLANE(tex, n, x0, x1, y0, y1, z0, f.x, f.y),
+                             VOL_TEXEL_PLANE(tex, n, x0, x1, y0, y1, z1, f.x, f.y), f.z);
   return VOL_MAKE4(c.x / (VOL_REAL)255, c.y / (VOL_REAL)255, c.z / (VOL_REAL)255, c.w / (VOL_REAL)255);
 }
+
+/* Its R channel alone (the shape noise), the same arithmetic on that channel: where the includer
+ * has planes of R alone (VOL_TEXEL_PLANE_R, the CPU lanes' 2 x 2 blocks of R) a slice is one load
+ * per lane instead of two 8-byte ones. */
+#ifdef VOL_TEXEL_PLANE_R
+VOL_FN VOL_REAL vol_noise_trilinear_r(VOL_GLOBAL const VOL_BYTE* tex, int n, VOL_V3 uvw) {
+  VOL_INT x0, x1, y0, y1, z0, z1;
+  VOL_V3 f;
+  vol_noise_cell(n, uvw, &x0, &x1, &y0, &y1, &z0, &z1, &f);
+  return vol_lerp(VOL_TEXEL_PLANE_R(tex, n, x0, y0, z0, f.x, f.y), VOL_TEXEL_PLANE_R(tex, n, x0, y0, z1, f.x, f.y),
+                  f.z) /
+         (VOL_REAL)255;
+}
+#define VOL_NOISE_R(tex, n, uvw) vol_noise_trilinear_r((tex), (n), (uvw))
+#endif
 
 /* The includer may replace the sample (the image variant: the sampler's linear filter). */
 #ifndef VOL_NOISE_SAMPLE
 #define VOL_NOISE_SAMPLE(tex, n, uvw) vol_noise_trilinear((tex), (n), (uvw))
+#endif
+#ifndef VOL_NOISE_R
+#define VOL_NOISE_R(tex, n, uvw) VOL_NOISE_SAMPLE(tex, n, uvw).x
 #endif
 #ifndef VOL_NOISE_PARAM
 #define VOL_NOISE_PARAM VOL_GLOBAL const VOL_BYTE* noise
@@ -102,7 +135,7 @@ VOL_FN VOL_REAL vol_density_field(VOL_GLOBAL const float* vol, VOL_V3 p, VOL_U t
   const VOL_V3 uvw = VOL_MAKE3((p.x + speed.x * time) * tiling.x, (p.y + speed.y * time) * tiling.y,
                                (p.z + speed.z * time) * tiling.z);
   const VOL_U cutoff = VOL_PU(vol, VOL_V_FOG_CUTOFF);
-  VOL_REAL fog = vol_pow(VOL_NOISE_SAMPLE(noise, noise_size, uvw).x, VOL_PU(vol, VOL_V_FOG_EXPONENT));
+  VOL_REAL fog = vol_pow(VOL_NOISE_R(noise, noise_size, uvw), VOL_PU(vol, VOL_V_FOG_EXPONENT));
   fog = vol_saturate((fog - cutoff) / ((VOL_U)1 - cutoff));
   if (detail) {
     const VOL_U strength = VOL_PU(vol, VOL_V_DETAIL_STRENGTH), e = VOL_PU(vol, VOL_V_DETAIL_EXPONENT);

@@ -368,5 +368,29 @@ const NoiseTexture& shared_noise_texture(int size, std::uint32_t seed) {
   return *slot;
 }
 
+const std::vector<std::uint8_t>& shared_noise_r_blocks(const NoiseTexture& texture) {
+  static std::mutex mutex;
+  static std::map<const NoiseTexture*, std::vector<std::uint8_t>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::vector<std::uint8_t>& blocks = cache[&texture];
+  if (blocks.empty()) {
+    const int n = texture.size, mask = n - 1;
+    const auto r = [&](int x, int y, int z) {
+      return texture.texels[4 * ((std::size_t(z) * n + (y & mask)) * n + (x & mask))];
+    };
+    blocks.resize(4 * std::size_t(n) * n * n);
+    std::uint8_t* w = blocks.data();
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x, w += 4) {
+          w[0] = r(x, y, z);
+          w[1] = r(x + 1, y, z);
+          w[2] = r(x, y + 1, z);
+          w[3] = r(x + 1, y + 1, z);
+        }
+  }
+  return blocks;
+}
+
 }  // namespace detail
 }  // namespace fogcl
