@@ -16,13 +16,15 @@
  * same: vectors by component, a parameter of the frame or a volume as a uniform VOL_U (float in
  * OpenCL C; VOL_REAL in C++), every per-lane decision as ?: on a comparison (a per-lane select
  * on vectors), VOL_ANY(m) to skip work no lane needs, and VOL_INT / VOL_TO_INT for integers
- * that differ per lane. Functions are overloadable in OpenCL C, so both instances keep their
- * names. */
+ * that differ per lane. The lanes kernel makes the functions overloadable, so both instances
+ * keep their names. */
 #ifndef FOGCL_VOLUME_COMMON_H
 #define FOGCL_VOLUME_COMMON_H
 
 #ifdef __OPENCL_C_VERSION__
-#define VOL_FN static inline __attribute__((overloadable))
+#ifndef VOL_FN /* the lanes kernel makes them overloadable */
+#define VOL_FN static inline
+#endif
 #define VOL_REAL float
 #define VOL_V3 float3
 #define VOL_V4 float4

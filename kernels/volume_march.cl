@@ -34,6 +34,14 @@
 #define FOG_EXP2 fog_exp2_poly
 #include "fog_math.h"
 
+#ifndef VOL_LANES
+#define VOL_LANES 1
+#endif
+#if VOL_LANES > 1
+/* Both instances of the shared functions keep their names (volume_common.h). */
+#define VOL_FN static inline __attribute__((overloadable))
+#endif
+
 #ifdef REVERSED_Z
 #define VOL_REVERSED_Z 1
 #else
@@ -50,10 +58,6 @@ constant sampler_t vol_noise_sampler = CLK_NORMALIZED_COORDS_TRUE | CLK_ADDRESS_
 #include "volume_ray.h"
 #include "volume_noise.h"
 #include "volume_integrate.h"
-
-#ifndef VOL_LANES
-#define VOL_LANES 1
-#endif
 
 #if VOL_LANES == 1
 kernel void volume_march(global const float* depth, global const float* frame, global const float* volumes,
