@@ -82,6 +82,9 @@ VOL_FN void vol_stylized_march(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_RE
         current = skip ? step * (VOL_REAL)VOL_ADAPTIVE_FACTOR : current;
         m = skip ? m - current * (VOL_REAL)VOL_ADAPTIVE_BACK : m;
         refined = refined || skip;
+#ifndef VOL_LANE_INSTANCE
+        continue; /* one ray: nothing else to do for this sample */
+#endif
       }
     }
     if (features & VOL_FEATURE_FADES) fog *= vol_fades(vol, p, t);
