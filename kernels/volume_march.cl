@@ -104,9 +104,10 @@ static inline __attribute__((always_inline)) vol_float4x16 vol_channels_x16(uint
  * whose lanes load the second again), so the x86 gathers fetch 64 elements per sample instead of
  * 128. The buffer is 4-byte aligned and one texel longer than the texture (volume_pass.cpp). */
 typedef ulong vol_ulong_a4 __attribute__((aligned(4)));
-static inline __attribute__((overloadable, always_inline)) vol_float4x16 vol_lerp4(vol_float4x16 a, vol_float4x16 b, float16 f);
-static inline __attribute__((always_inline)) vol_float4x16 vol_texel_row_x16(global const uchar* tex, int n, int16 x0, int16 x1, int16 y, int16 z,
-                                              float16 fx) {
+static inline __attribute__((overloadable, always_inline)) vol_float4x16 vol_lerp4(vol_float4x16 a, vol_float4x16 b,
+                                                                                 float16 f);
+static inline __attribute__((always_inline)) vol_float4x16 vol_texel_row_x16(global const uchar* tex, int n, int16 x0,
+                                                                             int16 x1, int16 y, int16 z, float16 fx) {
   const int16 row = (z * n + y) * n;
   global const uint* words = (global const uint*)tex;
   int at[16];
@@ -284,9 +285,9 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     covered[k] = hit[k] != 0u ? vol_covered(t_in[k], t_out[k], hit[k], count, a[k]) : 0.0f;
     pieces[k] = 0;
     j[k] = 0.0f;
-    live[k] = hit[k] != 0u &&
-              vol_lane_next_piece(t_in[k], t_out[k], hit[k], count, covered[k], &a[k], &b[k], &mask[k], &n[k], &pieces[k])
-                  ? -1 : 0;
+    const int first = hit[k] != 0u && vol_lane_next_piece(t_in[k], t_out[k], hit[k], count, covered[k], &a[k], &b[k],
+                                                          &mask[k], &n[k], &pieces[k]);
+    live[k] = first ? -1 : 0;
   }
   const float16 cos16 = vload16(0, cos_theta);
   float16 i_r = 0.0f, i_g = 0.0f, i_b = 0.0f, optical = 0.0f;

@@ -77,7 +77,8 @@ VOL_FN void vol_noise_cell(int n, VOL_V3 uvw, VOL_INT* x0, VOL_INT* x1, VOL_INT*
 /* Slice z of the cell: texels (x0, y), (x1, y) interpolated along x by fx for y0 and y1, then
  * along y by fy. The lanes instance loads each row's pair at once. */
 #ifndef VOL_TEXEL_ROW
-#define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) vol_lerp4(VOL_TEXEL(tex, n, x0, y, z), VOL_TEXEL(tex, n, x1, y, z), (fx))
+#define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) \
+  vol_lerp4(VOL_TEXEL(tex, n, x0, y, z), VOL_TEXEL(tex, n, x1, y, z), (fx))
 #endif
 #define VOL_TEXEL_PLANE(tex, n, x0, x1, y0, y1, z, fx, fy) \
   vol_lerp4(VOL_TEXEL_ROW(tex, n, x0, x1, y0, z, fx), VOL_TEXEL_ROW(tex, n, x0, x1, y1, z, fx), (fy))
