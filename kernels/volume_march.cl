@@ -1,6 +1,7 @@
 /* volume_march.cl — the march of the fog volumes into the reduced-resolution target
- * (docs/volumetric.md §The march). One work-item per target pixel; global size (ceil(W / s),
- * ceil(H / s)). The maths is in the shared headers, which the C++ paths compile too.
+ * (docs/volumetric.md §The march). One work-item per target pixel, global size (ceil(W / s),
+ * ceil(H / s)); on CPU devices 16 (VOL_LANES below). The maths is in the shared headers, which
+ * the C++ paths compile too.
  *
  * Variant switches (the host's volume_march_options(); none is optional):
  *   VOL_INTEGRATOR   1 stylized, 2 physical, 3 the physical model's textbook Riemann sum (comparison)
