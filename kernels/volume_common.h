@@ -7,12 +7,24 @@
  *     double for the reference), VOL_V3 glm::vec<3, VOL_REAL>.
  * Only operations both languages have appear: + - * / on reals and vectors, dot, length,
  * normalize, sqrt, exp, expm1, pow, floor, fmin, fmax, fabs, and the hooks below.
- * VOL_T(f) names a function whose real type cannot be deduced from its arguments. */
+ * VOL_T(f) names a function whose real type cannot be deduced from its arguments.
+ *
+ * A third instance, OpenCL C on 16 pixels (volume_march.cl with VOL_LANES 16, CPU devices,
+ * docs/volumetric.md §Lanes on CPU devices), compiles the per-sample functions again with
+ * VOL_REAL float16 (one lane per target pixel), VOL_V3 / VOL_V4 structs of float16 and
+ * VOL_LANE_INSTANCE defined. Those functions are written so that all three instances read the
+ * same: vectors by component, a parameter of the frame or a volume as a uniform VOL_U (float in
+ * OpenCL C; VOL_REAL in C++), every per-lane decision as ?: on a comparison (a per-lane select
+ * on vectors), VOL_ANY(m) to skip work no lane needs, and VOL_INT / VOL_TO_INT for integers
+ * that differ per lane. The lanes kernel makes the functions overloadable, so both instances
+ * keep their names. */
 #ifndef FOGCL_VOLUME_COMMON_H
 #define FOGCL_VOLUME_COMMON_H
 
 #ifdef __OPENCL_C_VERSION__
+#ifndef VOL_FN /* the lanes kernel makes them overloadable */
 #define VOL_FN static inline
+#endif
 #define VOL_REAL float
 #define VOL_V3 float3
 #define VOL_V4 float4
@@ -22,6 +34,11 @@
 #define VOL_T(f) f
 #define VOL_UINT uint
 #define VOL_BYTE uchar
+#define VOL_U float
+#define VOL_U3 float3
+#define VOL_MAKEU3(x, y, z) ((float3)((x), (y), (z)))
+#define VOL_INT int
+#define VOL_TO_INT(x) ((int)(x))
 #else
 #define VOL_FN template <typename VOL_REAL> inline
 #define VOL_V3 glm::vec<3, VOL_REAL>
@@ -32,11 +49,20 @@
 #define VOL_T(f) f<VOL_REAL>
 #define VOL_UINT std::uint32_t
 #define VOL_BYTE std::uint8_t
+#define VOL_U VOL_REAL
+#define VOL_U3 VOL_V3
+#define VOL_MAKEU3(x, y, z) VOL_V3((x), (y), (z))
+#define VOL_INT int
+#define VOL_TO_INT(x) int(x)
 #endif
+#define VOL_ANY(m) (m) /* the lanes instance: any(m) */
 
 /* A packed parameter, read in the path's precision. */
 #define VOL_P(array, index) ((VOL_REAL)(array)[index])
 #define VOL_P3(array, index) VOL_MAKE3(VOL_P(array, index), VOL_P(array, (index) + 1), VOL_P(array, (index) + 2))
+/* ... as a uniform: the same value in every lane. */
+#define VOL_PU(array, index) ((VOL_U)(array)[index])
+#define VOL_PU3(array, index) VOL_MAKEU3(VOL_PU(array, index), VOL_PU(array, (index) + 1), VOL_PU(array, (index) + 2))
 #define VOL_P4(array, index) \
   VOL_MAKE4(VOL_P(array, index), VOL_P(array, (index) + 1), VOL_P(array, (index) + 2), VOL_P(array, (index) + 3))
 

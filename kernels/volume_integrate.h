@@ -14,11 +14,12 @@
 
 /* Henyey-Greenstein phase function, normalised over the sphere (1 / 4 pi when g = 0); cos_theta
  * between the ray and the direction toward the light (forward scattering peaks looking at it). */
-VOL_FN VOL_REAL vol_phase_hg(VOL_REAL cos_theta, VOL_REAL g) {
+VOL_FN VOL_REAL vol_phase_hg(VOL_REAL cos_theta, VOL_U g) {
   const VOL_REAL denom = (VOL_REAL)1 + g * g - (VOL_REAL)2 * g * cos_theta;
   return ((VOL_REAL)1 - g * g) / ((VOL_REAL)(4.0 * 3.14159265358979323846) * denom * sqrt(denom));
 }
 
+#ifndef VOL_LANE_INSTANCE /* the lanes kernel looks up each lane's shadow with this one */
 /* 1 where world point p is lit, 0 in shadow: p is projected by the world -> light clip matrix
  * (column-major) and compared with the map's nearest texel, with the bias toward lit. Points
  * outside the map, behind the light, or over a NaN texel are lit. */
@@ -40,44 +41,68 @@ VOL_FN VOL_REAL vol_shadow_lit(VOL_V3 p, VOL_GLOBAL const float* frame, VOL_GLOB
   return shadowed ? (VOL_REAL)0 : (VOL_REAL)1;
 }
 
+#endif /* VOL_LANE_INSTANCE */
+
 /* stylized: one volume as the seed's shader draws it, (rgb, alpha) before blending. [front,
  * back] is the ray's part inside the sphere, t_scene the occluder. The march covers
  * min((t_scene - front) * occluder_overshoot, thickness) in `steps` steps from a start offset of
  * -jitter * step * 0.1; the first sample whose noise exceeds 0.1 switches to steps of 0.2 * step
  * after going back 4 of them, and is itself skipped (the seed's adaptive stepping, never back to
- * full steps). Alpha is fog_color.a * saturate(saturate(accumulation / distance) * density). */
-VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_REAL back,
-                                  VOL_REAL t_scene, VOL_REAL jitter, VOL_GLOBAL const float* vol,
-                                  VOL_GLOBAL const float* frame, VOL_NOISE_PARAM, int noise_size,
-                                  VOL_GLOBAL const float* shadow_map, int steps, int features) {
+ * full steps). Alpha is fog_color.a * saturate(saturate(accumulation / distance) * density).
+ * Three parts, so the lanes kernel runs the first two on 16 rays at once: the reach, the steps,
+ * the shading. */
+VOL_FN VOL_REAL vol_stylized_reach(VOL_REAL front, VOL_REAL back, VOL_REAL t_scene, VOL_U overshoot) {
   const VOL_REAL thickness = back - front;
-  const VOL_REAL reach = t_scene < (VOL_REAL)INFINITY
-                             ? fmin((t_scene - front) * VOL_P(vol, VOL_V_OVERSHOOT), thickness)
-                             : thickness;
-  if (!(reach > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
-  const VOL_REAL step = reach / (VOL_REAL)steps, time = VOL_P(frame, VOL_F_TIME);
-  const int noisy = (features & VOL_FEATURE_NOISE) && VOL_P(vol, VOL_V_NOISE) != (VOL_REAL)0;
-  VOL_REAL marched = -jitter * step * (VOL_REAL)VOL_JITTER_SPAN, current = step;
-  VOL_REAL accumulation = 0, shadowed = 0;
-  int refined = !(features & VOL_FEATURE_ADAPTIVE);
+  return t_scene < (VOL_REAL)INFINITY ? fmin((t_scene - front) * overshoot, thickness) : thickness;
+}
+
+/* The steps over [front, front + reach]: the accumulated fog, the shadowed length and the
+ * distance marched. The adaptive switch is a per-lane select (the refining sample adds nothing),
+ * not a `continue`, so every lane runs the same `steps` iterations. */
+VOL_FN void vol_stylized_march(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_REAL reach, VOL_REAL jitter,
+                               VOL_GLOBAL const float* vol, VOL_GLOBAL const float* frame, VOL_NOISE_PARAM,
+                               int noise_size, VOL_GLOBAL const float* shadow_map, int steps, int features,
+                               VOL_REAL* accumulation, VOL_REAL* shadowed, VOL_REAL* marched) {
+  const VOL_REAL step = reach / (VOL_REAL)steps;
+  const VOL_U time = VOL_PU(frame, VOL_F_TIME);
+  const int noisy = (features & VOL_FEATURE_NOISE) && VOL_PU(vol, VOL_V_NOISE) != (VOL_U)0;
+  VOL_REAL m = -jitter * step * (VOL_REAL)VOL_JITTER_SPAN, current = step;
+  VOL_REAL acc = (VOL_REAL)0, shade = (VOL_REAL)0;
+  VOL_INT refined = !(features & VOL_FEATURE_ADAPTIVE);
   for (int i = 0; i < steps; ++i) {
-    marched += current;
-    const VOL_REAL t = front + marched;
-    const VOL_V3 p = origin + dir * t;
+    m += current;
+    const VOL_REAL t = front + m;
+    const VOL_V3 p = VOL_MAKE3(origin.x + dir.x * t, origin.y + dir.y * t, origin.z + dir.z * t);
     VOL_REAL fog = noisy ? vol_density_field(vol, p, time, noise, noise_size, features & VOL_FEATURE_DETAIL)
                          : (VOL_REAL)1;
-    if (!refined && fog > (VOL_REAL)VOL_ADAPTIVE_ONSET) {
-      current = step * (VOL_REAL)VOL_ADAPTIVE_FACTOR;
-      marched -= current * (VOL_REAL)VOL_ADAPTIVE_BACK;
-      refined = 1;
-      continue;
+    VOL_INT skip = 0;
+    if (features & VOL_FEATURE_ADAPTIVE) {
+      skip = !refined && fog > (VOL_REAL)VOL_ADAPTIVE_ONSET;
+      if (VOL_ANY(skip)) {
+        current = skip ? step * (VOL_REAL)VOL_ADAPTIVE_FACTOR : current;
+        m = skip ? m - current * (VOL_REAL)VOL_ADAPTIVE_BACK : m;
+        refined = refined || skip;
+#ifndef VOL_LANE_INSTANCE
+        continue; /* one ray: nothing else to do for this sample */
+#endif
+      }
     }
     if (features & VOL_FEATURE_FADES) fog *= vol_fades(vol, p, t);
-    if (features & VOL_FEATURE_SHADOW)
-      shadowed += ((VOL_REAL)1 - vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)) * current;
-    accumulation += fog * current;
+    if (features & VOL_FEATURE_SHADOW) {
+      const VOL_REAL lit = vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED);
+      shade = skip ? shade : shade + ((VOL_REAL)1 - lit) * current;
+    }
+    acc = skip ? acc : acc + fog * current;
   }
-  if (!(marched > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  *accumulation = acc;
+  *shadowed = shade;
+  *marched = m;
+}
+
+#ifndef VOL_LANE_INSTANCE
+/* The colour and alpha of a marched volume (marched > 0) seen along dir. */
+VOL_FN VOL_V4 vol_stylized_shade(VOL_V3 dir, VOL_REAL accumulation, VOL_REAL shadowed, VOL_REAL marched,
+                                 VOL_GLOBAL const float* vol, VOL_GLOBAL const float* frame, int features) {
   /* The lobe toward the light bends colour and light (the seed's k). */
   const VOL_V3 light_dir = VOL_P3(frame, VOL_F_LIGHT_DIR), light = VOL_P3(frame, VOL_F_LIGHT_COLOR);
   const VOL_REAL k = vol_pow(vol_saturate(dot(dir, light_dir)), VOL_P(vol, VOL_V_DIR_FALLOFF));
@@ -99,30 +124,113 @@ VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL
   return VOL_MAKE4(rgb.x, rgb.y, rgb.z, alpha);
 }
 
+VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL_REAL back,
+                                  VOL_REAL t_scene, VOL_REAL jitter, VOL_GLOBAL const float* vol,
+                                  VOL_GLOBAL const float* frame, VOL_NOISE_PARAM, int noise_size,
+                                  VOL_GLOBAL const float* shadow_map, int steps, int features) {
+  const VOL_REAL reach = vol_stylized_reach(front, back, t_scene, VOL_P(vol, VOL_V_OVERSHOOT));
+  if (!(reach > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  VOL_REAL accumulation, shadowed, marched;
+  vol_stylized_march(origin, dir, front, reach, jitter, vol, frame, noise, noise_size, shadow_map, steps, features,
+                     &accumulation, &shadowed, &marched);
+  if (!(marched > (VOL_REAL)0)) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  return vol_stylized_shade(dir, accumulation, shadowed, marched, vol, frame, features);
+}
+
+#endif /* VOL_LANE_INSTANCE */
+
 /* The extinction [1/world] and the albedo-weighted light of the volumes of `mask` at p, t:
  * sigma_t = density * field * fades per volume, summed; *source = sum of sigma_t * albedo * L with
- * L = light * phase * shadow + ambient. */
+ * L = light * phase * shadow + ambient. A volume adds where its bit is set (a per-lane select). */
 VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, VOL_REAL cos_theta, VOL_REAL lit, VOL_UINT mask,
                                     VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
                                     VOL_NOISE_PARAM, int noise_size, int features, VOL_V3* source) {
-  const VOL_V3 light = VOL_P3(frame, VOL_F_LIGHT_COLOR);
-  const VOL_REAL time = VOL_P(frame, VOL_F_TIME);
-  VOL_REAL sigma_t = 0;
-  VOL_V3 s = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  const VOL_U3 light = VOL_PU3(frame, VOL_F_LIGHT_COLOR);
+  const VOL_U time = VOL_PU(frame, VOL_F_TIME);
+  VOL_REAL sigma_t = (VOL_REAL)0, s_r = (VOL_REAL)0, s_g = (VOL_REAL)0, s_b = (VOL_REAL)0;
   for (int i = 0; i < count; ++i) {
-    if (!((mask >> i) & 1u)) continue;
+    const VOL_INT in = ((mask >> i) & 1u) != 0u;
+    if (!VOL_ANY(in)) continue;
     VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
-    VOL_REAL sigma = VOL_P(vol, VOL_V_DENSITY);
-    if ((features & VOL_FEATURE_NOISE) && VOL_P(vol, VOL_V_NOISE) != (VOL_REAL)0)
+    VOL_REAL sigma = (VOL_REAL)VOL_PU(vol, VOL_V_DENSITY);
+    if ((features & VOL_FEATURE_NOISE) && VOL_PU(vol, VOL_V_NOISE) != (VOL_U)0)
       sigma *= vol_density_field(vol, p, time, noise, noise_size, features & VOL_FEATURE_DETAIL);
     if (features & VOL_FEATURE_FADES) sigma *= vol_fades(vol, p, t);
-    const VOL_V3 in_light = light * (vol_phase_hg(cos_theta, VOL_P(vol, VOL_V_ANISOTROPY)) * lit) +
-                            VOL_P3(vol, VOL_V_AMBIENT);
-    s = s + VOL_P3(vol, VOL_V_ALBEDO) * in_light * sigma;
-    sigma_t += sigma;
+    const VOL_REAL phase_lit = vol_phase_hg(cos_theta, VOL_PU(vol, VOL_V_ANISOTROPY)) * lit;
+    const VOL_U3 albedo = VOL_PU3(vol, VOL_V_ALBEDO), ambient = VOL_PU3(vol, VOL_V_AMBIENT);
+    s_r = in ? s_r + albedo.x * (light.x * phase_lit + ambient.x) * sigma : s_r;
+    s_g = in ? s_g + albedo.y * (light.y * phase_lit + ambient.y) * sigma : s_g;
+    s_b = in ? s_b + albedo.z * (light.z * phase_lit + ambient.z) * sigma : s_b;
+    sigma_t = in ? sigma_t + sigma : sigma_t;
   }
-  *source = s;
+  *source = VOL_MAKE3(s_r, s_g, s_b);
   return sigma_t;
+}
+
+/* physical: the weight of a segment of length seg with extinction sigma_t > 0 after optical
+ * depth `depth`, T * (1 - e^(-sigma_t seg)) / sigma_t; riemann: the textbook T * seg. */
+VOL_FN VOL_REAL vol_segment_weight(VOL_REAL sigma_t, VOL_REAL seg, VOL_REAL depth, int riemann) {
+  return riemann ? seg * exp(-depth) : -expm1(-sigma_t * seg) * exp(-depth) / sigma_t;
+}
+
+/* physical: where segment j of the n of the piece [a, a + length] starts (j = n: the piece's end,
+ * which the caller takes as b exactly). j and n are small integers, exact as reals. */
+VOL_FN VOL_REAL vol_segment_start(VOL_REAL a, VOL_REAL length, VOL_REAL j, VOL_REAL n) { return a + length * j / n; }
+
+#ifndef VOL_LANE_INSTANCE
+/* physical: the piece of the ray that starts at a and ends at the next sphere boundary *b (+inf:
+ * none left), and the volumes of `hit` that cover all of it. */
+VOL_FN VOL_UINT vol_piece(const VOL_REAL* t_in, const VOL_REAL* t_out, VOL_UINT hit, int count, VOL_REAL a,
+                          VOL_REAL* b) {
+  VOL_REAL end = (VOL_REAL)INFINITY;
+  for (int i = 0; i < count; ++i) {
+    if (!((hit >> i) & 1u)) continue;
+    if (t_in[i] > a) end = fmin(end, t_in[i]);
+    if (t_out[i] > a) end = fmin(end, t_out[i]);
+  }
+  VOL_UINT mask = 0u;
+  for (int i = 0; i < count; ++i)
+    if (((hit >> i) & 1u) && t_in[i] <= a && t_out[i] >= end) mask |= 1u << i;
+  *b = end;
+  return mask;
+}
+
+/* physical: the segments of a piece of length `length`, its share of the covered length's steps. */
+VOL_FN int vol_piece_segments(VOL_REAL length, int steps, VOL_REAL covered) {
+  return max(1, (int)floor(length * (VOL_REAL)steps / covered + (VOL_REAL)0.5f));
+}
+
+/* physical: the spheres of the ray, clipped to [0, t_scene]: t_in / t_out of the volumes of the
+ * returned bit set, *start the nearest entry. */
+VOL_FN VOL_UINT vol_physical_hits(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_GLOBAL const float* vols, int count,
+                                  VOL_REAL* t_in, VOL_REAL* t_out, VOL_REAL* start) {
+  VOL_UINT hit = 0u;
+  *start = (VOL_REAL)INFINITY;
+  for (int i = 0; i < count; ++i) {
+    VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
+    VOL_REAL t0, t1;
+    if (!vol_sphere_hit(origin, dir, VOL_P3(vol, VOL_V_CENTER), VOL_P(vol, VOL_V_RADIUS), &t0, &t1)) continue;
+    t1 = fmin(t1, t_scene);
+    if (!(t1 > t0)) continue;
+    t_in[i] = t0;
+    t_out[i] = t1;
+    hit |= 1u << i;
+    *start = fmin(*start, t0);
+  }
+  return hit;
+}
+
+/* physical: the length of the ray inside some sphere (the pieces with volumes). */
+VOL_FN VOL_REAL vol_covered(const VOL_REAL* t_in, const VOL_REAL* t_out, VOL_UINT hit, int count, VOL_REAL start) {
+  VOL_REAL covered = 0, a = start;
+  for (int piece = 0; piece < 2 * count; ++piece) {
+    VOL_REAL b;
+    const VOL_UINT mask = vol_piece(t_in, t_out, hit, count, a, &b);
+    if (!(b < (VOL_REAL)INFINITY)) break;
+    if (mask != 0u) covered += b - a;
+    a = b;
+  }
+  return covered;
 }
 
 /* physical (Hillaire 2015, "Physically Based and Unified Volumetric Rendering in Frostbite"):
@@ -139,71 +247,74 @@ VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, VOL_REAL cos_theta, VO
  * riemann != 0 (VOL_RIEMANN, for comparison only: fogcl report --volumetric, the stiffness test)
  * replaces the segment's exact weight by the textbook left Riemann sum I += T * source * d with T
  * at the segment's start: not energy-conserving, it overshoots by up to sigma_t d when
- * sigma_t d >> 1. */
+ * sigma_t d >> 1. The lanes kernel walks the same pieces and segments per lane. */
 VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL jitter,
                            VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
                            VOL_NOISE_PARAM, int noise_size, VOL_GLOBAL const float* shadow_map,
                            int steps, int features, int riemann) {
-  VOL_REAL t_in[VOL_MAX_VOLUMES], t_out[VOL_MAX_VOLUMES];
-  VOL_REAL start = (VOL_REAL)INFINITY;
-  VOL_UINT hit = 0u;
-  for (int i = 0; i < count; ++i) {
-    VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
-    VOL_REAL t0, t1;
-    if (!vol_sphere_hit(origin, dir, VOL_P3(vol, VOL_V_CENTER), VOL_P(vol, VOL_V_RADIUS), &t0, &t1)) continue;
-    t1 = fmin(t1, t_scene);
-    if (!(t1 > t0)) continue;
-    t_in[i] = t0;
-    t_out[i] = t1;
-    hit |= 1u << i;
-    start = fmin(start, t0);
-  }
+  VOL_REAL t_in[VOL_MAX_VOLUMES], t_out[VOL_MAX_VOLUMES], start;
+  const VOL_UINT hit = vol_physical_hits(origin, dir, t_scene, vols, count, t_in, t_out, &start);
   VOL_REAL i_r = 0, i_g = 0, i_b = 0, depth = 0;
   if (hit == 0u) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   const VOL_REAL cos_theta = dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR));
-  VOL_REAL covered = 0;
-  /* Pass 0 measures the covered length, pass 1 integrates. */
-  for (int pass = 0; pass < 2; ++pass) {
-    VOL_REAL a = start;
-    for (int piece = 0; piece < 2 * count; ++piece) {
-      VOL_REAL b = (VOL_REAL)INFINITY;
-      for (int i = 0; i < count; ++i) {
-        if (!((hit >> i) & 1u)) continue;
-        if (t_in[i] > a) b = fmin(b, t_in[i]);
-        if (t_out[i] > a) b = fmin(b, t_out[i]);
-      }
-      if (!(b < (VOL_REAL)INFINITY)) break;
-      VOL_UINT mask = 0u;
-      for (int i = 0; i < count; ++i)
-        if (((hit >> i) & 1u) && t_in[i] <= a && t_out[i] >= b) mask |= 1u << i;
+  const VOL_REAL covered = vol_covered(t_in, t_out, hit, count, start);
+  VOL_REAL a = start;
+  for (int piece = 0; piece < 2 * count; ++piece) {
+    VOL_REAL b;
+    const VOL_UINT mask = vol_piece(t_in, t_out, hit, count, a, &b);
+    if (!(b < (VOL_REAL)INFINITY)) break;
+    if (mask != 0u) {
       const VOL_REAL length_ab = b - a;
-      if (mask != 0u && pass == 0) covered += length_ab;
-      if (mask != 0u && pass == 1) {
-        const int n = max(1, (int)floor(length_ab * (VOL_REAL)steps / covered + (VOL_REAL)0.5f));
-        for (int j = 0; j < n; ++j) {
-          const VOL_REAL s0 = a + length_ab * (VOL_REAL)j / (VOL_REAL)n;
-          const VOL_REAL s1 = j + 1 == n ? b : a + length_ab * (VOL_REAL)(j + 1) / (VOL_REAL)n;
-          const VOL_REAL seg = s1 - s0, t = s0 + jitter * seg;
-          const VOL_V3 p = origin + dir * t;
-          const VOL_REAL lit = (features & VOL_FEATURE_SHADOW)
-                                   ? vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)
-                                   : (VOL_REAL)1;
-          VOL_V3 source;
-          const VOL_REAL sigma_t = vol_physical_sample(p, t, cos_theta, lit, mask, vols, count, frame, noise,
-                                                       noise_size, features, &source);
-          if (!(sigma_t > (VOL_REAL)0)) continue;
-          const VOL_REAL scatter =
-              riemann ? seg * exp(-depth) : -expm1(-sigma_t * seg) * exp(-depth) / sigma_t;
-          i_r += source.x * scatter;
-          i_g += source.y * scatter;
-          i_b += source.z * scatter;
-          depth += sigma_t * seg;
-        }
+      const int n = vol_piece_segments(length_ab, steps, covered);
+      for (int j = 0; j < n; ++j) {
+        const VOL_REAL s0 = vol_segment_start(a, length_ab, (VOL_REAL)j, (VOL_REAL)n);
+        const VOL_REAL s1 = j + 1 == n ? b : vol_segment_start(a, length_ab, (VOL_REAL)(j + 1), (VOL_REAL)n);
+        const VOL_REAL seg = s1 - s0, t = s0 + jitter * seg;
+        const VOL_V3 p = origin + dir * t;
+        const VOL_REAL lit = (features & VOL_FEATURE_SHADOW)
+                                 ? vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)
+                                 : (VOL_REAL)1;
+        VOL_V3 source;
+        const VOL_REAL sigma_t = vol_physical_sample(p, t, cos_theta, lit, mask, vols, count, frame, noise,
+                                                     noise_size, features, &source);
+        if (!(sigma_t > (VOL_REAL)0)) continue;
+        const VOL_REAL scatter = vol_segment_weight(sigma_t, seg, depth, riemann);
+        i_r += source.x * scatter;
+        i_g += source.y * scatter;
+        i_b += source.z * scatter;
+        depth += sigma_t * seg;
       }
-      a = b;
     }
+    a = b;
   }
   return VOL_MAKE4(i_r, i_g, i_b, -expm1(-depth));
+}
+
+/* The target pixel (lx, ly) as the march sees it: its ray, the distance along it to the occluder,
+ * and the block's eye depth in *key for the upsampling. */
+VOL_FN void vol_pixel_view(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
+                           int projection, int reversed_z, VOL_V3* origin, VOL_V3* dir, VOL_REAL* t_scene,
+                           VOL_REAL* key) {
+  const int scale = (int)VOL_P(frame, VOL_F_SCALE);
+  const VOL_REAL near_plane = VOL_P(frame, VOL_F_NEAR);
+  const VOL_REAL eye_depth = vol_block_eye_depth(depth_buffer, lx, ly, scale, (int)VOL_P(frame, VOL_F_WIDTH),
+                                                 (int)VOL_P(frame, VOL_F_HEIGHT), projection, reversed_z,
+                                                 VOL_P(frame, VOL_F_ZX), VOL_P(frame, VOL_F_ZY), near_plane,
+                                                 VOL_P(frame, VOL_F_FAR));
+  *key = eye_depth;
+  VOL_REAL t_per_eye;
+  const VOL_REAL block_centre = (VOL_REAL)scale * (VOL_REAL)0.5f;
+  vol_pixel_ray((VOL_REAL)(lx * scale) + block_centre, (VOL_REAL)(ly * scale) + block_centre, frame, projection, origin,
+                dir, &t_per_eye);
+  *t_scene = vol_scene_distance(eye_depth, near_plane, t_per_eye);
+}
+
+/* stylized: the volume's (rgb, alpha) c drawn over the target with the seed's blend (SrcAlpha,
+ * OneMinusSrcAlpha; One, OneMinusSrcAlpha): premultiplied colour and coverage. */
+VOL_FN VOL_V4 vol_over(VOL_V4 target, VOL_V4 c) {
+  const VOL_REAL keep = (VOL_REAL)1 - c.w;
+  return VOL_MAKE4(c.x * c.w + target.x * keep, c.y * c.w + target.y * keep, c.z * c.w + target.z * keep,
+                   c.w + target.w * keep);
 }
 
 /* The target pixel (lx, ly): its ray, its occluder, the march of the chosen integrator. Returns
@@ -212,36 +323,23 @@ VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buff
                               VOL_GLOBAL const float* vols, int count, VOL_NOISE_PARAM, int noise_size,
                               VOL_GLOBAL const float* shadow_map, VOL_UINT frame_index, int integrator, int steps,
                               int features, int jitter, int projection, int reversed_z, VOL_REAL* key) {
-  const int scale = (int)VOL_P(frame, VOL_F_SCALE);
-  const VOL_REAL near_plane = VOL_P(frame, VOL_F_NEAR);
-  const VOL_REAL eye_depth = vol_block_eye_depth(depth_buffer, lx, ly, scale, (int)VOL_P(frame, VOL_F_WIDTH),
-                                                 (int)VOL_P(frame, VOL_F_HEIGHT), projection, reversed_z,
-                                                 VOL_P(frame, VOL_F_ZX), VOL_P(frame, VOL_F_ZY), near_plane,
-                                                 VOL_P(frame, VOL_F_FAR));
-  *key = eye_depth;
   VOL_V3 origin, dir;
-  VOL_REAL t_per_eye;
-  const VOL_REAL block_centre = (VOL_REAL)scale * (VOL_REAL)0.5f;
-  vol_pixel_ray((VOL_REAL)(lx * scale) + block_centre, (VOL_REAL)(ly * scale) + block_centre, frame, projection, &origin, &dir,
-                &t_per_eye);
-  const VOL_REAL t_scene = vol_scene_distance(eye_depth, near_plane, t_per_eye);
+  VOL_REAL t_scene;
+  vol_pixel_view(lx, ly, depth_buffer, frame, projection, reversed_z, &origin, &dir, &t_scene, key);
   const float j = vol_jitter((VOL_UINT)lx, (VOL_UINT)ly, frame_index);
   if (integrator != VOL_STYLIZED)
     return vol_physical(origin, dir, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame, noise,
                         noise_size, shadow_map, steps, features, integrator == VOL_RIEMANN);
-  /* stylized: each volume drawn over the target in the order given, with the seed's blend
-   * (SrcAlpha, OneMinusSrcAlpha; One, OneMinusSrcAlpha): premultiplied colour and coverage. */
+  /* stylized: each volume drawn over the target in the order given. */
   VOL_V4 target = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   for (int i = 0; i < count; ++i) {
     VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
     VOL_REAL t0, t1;
     if (!vol_sphere_hit(origin, dir, VOL_P3(vol, VOL_V_CENTER), VOL_P(vol, VOL_V_RADIUS), &t0, &t1)) continue;
     if (!(t0 < t_scene)) continue;
-    const VOL_V4 c = vol_stylized_volume(origin, dir, t0, t1, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0, vol, frame,
-                                         noise, noise_size, shadow_map, steps, features);
-    const VOL_REAL keep = (VOL_REAL)1 - c.w;
-    target = VOL_MAKE4(c.x * c.w + target.x * keep, c.y * c.w + target.y * keep, c.z * c.w + target.z * keep,
-                       c.w + target.w * keep);
+    target = vol_over(target, vol_stylized_volume(origin, dir, t0, t1, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0, vol,
+                                                  frame, noise, noise_size, shadow_map, steps, features));
   }
   return target;
 }
+#endif /* VOL_LANE_INSTANCE */

@@ -327,8 +327,16 @@ int integrator_code(VolumeIntegrator integrator) {
   throw Error("volume integrator " + std::to_string(int(integrator)) + " is not one of stylized, physical, riemann");
 }
 
+int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
+  // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
+  // work-items, which the march's loops prevent; the lanes instance has no image sampling.
+  const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
+  return device.cpu && buffer ? 16 : 1;
+}
+
 std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& device) {
   std::string o = cl_std_option(device);
+  if (const int lanes = volume_march_lanes(v, device); lanes > 1) o += " -D VOL_LANES=" + std::to_string(lanes);
   o += " -D VOL_INTEGRATOR=" + std::to_string(integrator_code(v.integrator));
   o += " -D VOL_STEPS=" + std::to_string(v.steps);
   o += " -D VOL_FEATURES=" + std::to_string(v.features);
@@ -360,6 +368,30 @@ const NoiseTexture& shared_noise_texture(int size, std::uint32_t seed) {
   auto& slot = cache[{size, seed}];
   if (!slot) slot = std::make_unique<NoiseTexture>(make_noise_texture(size, seed));
   return *slot;
+}
+
+const std::vector<std::uint8_t>& shared_noise_r_blocks(const NoiseTexture& texture) {
+  static std::mutex mutex;
+  static std::map<const NoiseTexture*, std::vector<std::uint8_t>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::vector<std::uint8_t>& blocks = cache[&texture];
+  if (blocks.empty()) {
+    const int n = texture.size, mask = n - 1;
+    const auto r = [&](int x, int y, int z) {
+      return texture.texels[4 * ((std::size_t(z) * n + (y & mask)) * n + (x & mask))];
+    };
+    blocks.resize(4 * std::size_t(n) * n * n);
+    std::uint8_t* w = blocks.data();
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x, w += 4) {
+          w[0] = r(x, y, z);
+          w[1] = r(x + 1, y, z);
+          w[2] = r(x, y + 1, z);
+          w[3] = r(x + 1, y + 1, z);
+        }
+  }
+  return blocks;
 }
 
 }  // namespace detail

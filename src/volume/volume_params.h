@@ -49,10 +49,19 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
 // VOL_STYLIZED, VOL_PHYSICAL or VOL_RIEMANN (kernels/volume_common.h): the march's integrator switch.
 int integrator_code(VolumeIntegrator integrator);
 
+// Target pixels per work-item of the march (VOL_LANES): 16 on CPU devices where the lanes
+// instance applies, else 1. The global size's x is ceil(low_width / lanes).
+int volume_march_lanes(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_march_options(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_composite_options(const VolumeVariant& variant, const DeviceTraits& device);
 
 // The noise texture of (size, seed), generated once per process and shared (thread-safe).
 const NoiseTexture& shared_noise_texture(int size, std::uint32_t seed);
+
+// The texture's R channel as 2 x 2 blocks for the CPU lanes of the march (kernels/volume_march.cl,
+// vol_texel_plane_r_x16): N^3 words, the word of (x, y, z) holding R(x, y), R(x + 1, y),
+// R(x, y + 1), R(x + 1, y + 1) of slice z from the lowest byte, coordinates wrapped. Made once per
+// texture of shared_noise_texture (thread-safe).
+const std::vector<std::uint8_t>& shared_noise_r_blocks(const NoiseTexture& texture);
 
 }  // namespace fogcl::detail

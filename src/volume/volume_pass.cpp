@@ -118,8 +118,16 @@ const cl::Memory& VolumePass::Impl::noise_on_device(const cl::CommandQueue& q, c
                           nullptr, &uploaded);
       memory = img;
     } else {
-      cl::Buffer buf(context, CL_MEM_READ_ONLY, tex.texels.size());
-      q.enqueueWriteBuffer(buf, CL_FALSE, 0, tex.texels.size(), tex.texels.data(), nullptr, &uploaded);
+      // One texel of slack past the end: the march's lanes read texels (x, x + 1) as one 8-byte
+      // word (kernels/volume_march.cl) and at the last texel the second half is never used. CPU
+      // devices (the lanes) get the 2 x 2 blocks of R after it.
+      const std::size_t bytes = tex.texels.size() + 4;
+      const std::vector<std::uint8_t>* blocks = traits.cpu ? &detail::shared_noise_r_blocks(tex) : nullptr;
+      cl::Buffer buf(context, CL_MEM_READ_ONLY, bytes + (blocks ? blocks->size() : 0));
+      std::vector<cl::Event> writes(blocks ? 2 : 1);
+      q.enqueueWriteBuffer(buf, CL_FALSE, 0, tex.texels.size(), tex.texels.data(), nullptr, &writes[0]);
+      if (blocks) q.enqueueWriteBuffer(buf, CL_FALSE, bytes, blocks->size(), blocks->data(), nullptr, &writes[1]);
+      q.enqueueMarkerWithWaitList(&writes, &uploaded);
       memory = buf;
     }
     ++stats.noise_uploads;
@@ -208,7 +216,9 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     march.setArg(arg++, low);
     march.setArg(arg++, low_key);
     cl::Event marched;
-    queue.enqueueNDRangeKernel(march, cl::NullRange, cl::NDRange(f.low_width, f.low_height), cl::NullRange,
+    const int lanes = detail::volume_march_lanes(f.variant, m.traits);
+    queue.enqueueNDRangeKernel(march, cl::NullRange, cl::NDRange((f.low_width + lanes - 1) / lanes, f.low_height),
+                               cl::NullRange,
                                waits.empty() ? nullptr : &waits, &marched);
     ++m.stats.march_dispatches;
     composite.setArg(0, wrap(fb.color_in));
