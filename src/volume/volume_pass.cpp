@@ -216,8 +216,9 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     march.setArg(arg++, low);
     march.setArg(arg++, low_key);
     cl::Event marched;
-    const int lanes = detail::volume_march_lanes(f.variant, m.traits);
-    queue.enqueueNDRangeKernel(march, cl::NullRange, cl::NDRange((f.low_width + lanes - 1) / lanes, f.low_height),
+    const int march_lanes = detail::volume_march_lanes(f.variant, m.traits);  // target pixels per work-item
+    queue.enqueueNDRangeKernel(march, cl::NullRange,
+                               cl::NDRange((f.low_width + march_lanes - 1) / march_lanes, f.low_height),
                                cl::NullRange,
                                waits.empty() ? nullptr : &waits, &marched);
     ++m.stats.march_dispatches;
@@ -228,8 +229,9 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     composite.setArg(4, low);
     composite.setArg(5, low_key);
     const std::vector<cl::Event> after{marched};
-    const std::size_t lanes = std::size_t(pixels_per_work_item(m.traits));  // frame pixels per work-item
-    queue.enqueueNDRangeKernel(composite, cl::NullRange, cl::NDRange((fb.width + lanes - 1) / lanes, fb.height),
+    const std::size_t composite_lanes = std::size_t(pixels_per_work_item(m.traits));  // frame pixels per work-item
+    queue.enqueueNDRangeKernel(composite, cl::NullRange,
+                               cl::NDRange((fb.width + composite_lanes - 1) / composite_lanes, fb.height),
                                cl::NullRange, &after, &done);
     ++m.stats.composite_dispatches;
     return share(done);
