@@ -352,8 +352,6 @@ bool given(const VolumeCliOptions& o, const std::string& flag) {
   return std::find(o.given.begin(), o.given.end(), flag) != o.given.end();
 }
 
-const char* resolution_name(int divisor) { return divisor == 1 ? "full" : divisor == 2 ? "half" : "quarter"; }
-
 }  // namespace
 
 void add_volume_options(CLI::App& app, VolumeCliOptions& o) {

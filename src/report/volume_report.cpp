@@ -82,8 +82,6 @@ std::vector<FogVolume> scene_volumes(const std::string& name, VolumeIntegrator i
   return {v};
 }
 
-const char* resolution_name(int divisor) { return divisor == 1 ? "full" : divisor == 2 ? "half" : "quarter"; }
-
 struct DeviceResult {
   double time_ms = 0;
   ColorImage out;

@@ -145,6 +145,7 @@ const char* to_string(VolumeIntegrator i) {
   return "unknown";
 }
 const char* to_string(VolumeUpsampling u) { return u == VolumeUpsampling::depth_aware ? "depth-aware" : "bilinear"; }
+const char* resolution_name(int divisor) { return divisor == 1 ? "full" : divisor == 2 ? "half" : "quarter"; }
 const char* to_string(NoiseSampling s) { return s == NoiseSampling::buffer ? "buffer" : "image"; }
 
 namespace {

@@ -134,5 +134,7 @@ void validate(const VolumeScene& scene);
 const char* to_string(VolumeIntegrator integrator);
 const char* to_string(VolumeUpsampling upsampling);
 const char* to_string(NoiseSampling sampling);
+// VolumeSettings::resolution_divisor's name: 1 "full", 2 "half", 4 "quarter".
+const char* resolution_name(int divisor);
 
 }  // namespace fogcl
