@@ -1,28 +1,9 @@
 # fogcl report: the Pareto plot of error against run time, one panel per scene.
-# Embedded in the library (report_plot_py.h) and run as `python3 - DIR` with this text on stdin:
-# reads DIR/report.csv, writes DIR/report.png. Exit code 3: matplotlib is missing.
-import csv
-import math
-import os
-import sys
-
-try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    sys.stderr.write("matplotlib is missing\n")
-    sys.exit(3)
-
+# Embedded in the library (report_plot_py.h) and run after plot_common.py's text as `python3 - DIR`:
+# reads DIR/report.csv, writes DIR/report.png.
 FLOOR = 1e-12  # zero errors are drawn here on the log axis
 
-folder = sys.argv[1]
-with open(os.path.join(folder, "report.csv"), newline="") as f:
-    rows = list(csv.DictReader(f))
-scenes = []
-for r in rows:
-    if r["scene"] not in scenes:
-        scenes.append(r["scene"])
+rows, scenes = read_rows("report.csv")
 
 STYLE = {
     "precise-rgba32f": ("tab:blue", "o"),
@@ -34,10 +15,7 @@ STYLE = {
 
 
 def err(value):
-    v = float(value)
-    if math.isnan(v) or math.isinf(v):
-        return None
-    return max(v, FLOOR)
+    return clipped_error(value, FLOOR)
 
 
 cols = min(3, len(scenes))
@@ -57,11 +35,7 @@ for i, scene in enumerate(scenes):
         if p is not None:
             ax.scatter([t], [p], facecolors="none", edgecolors=color, marker=marker, s=46)
     # Pareto front of (time, max error): nothing else is both faster and more accurate.
-    front, best = [], float("inf")
-    for t, e in sorted(pts):
-        if e < best:
-            front.append((t, e))
-            best = e
+    front = pareto_front(pts)
     if len(front) > 1:
         ax.plot([p[0] for p in front], [p[1] for p in front], color="black", lw=0.8, ls="--", zorder=0)
     ax.set_yscale("log")
@@ -76,6 +50,4 @@ handles, labels = axes[0][0].get_legend_handles_labels()
 fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=9, frameon=False)
 fig.suptitle("fogcl: error against run time (dashed: Pareto front)")
 fig.tight_layout(rect=(0, 0.05, 1, 0.96))
-tmp = os.path.join(folder, ".report.png.tmp")
-fig.savefig(tmp, dpi=110, format="png")
-os.replace(tmp, os.path.join(folder, "report.png"))
+save_png(fig, "report.png", 110)

@@ -1,29 +1,10 @@
 # fogcl report --volumetric: the Pareto plot of error against run time, one panel per scene, and
 # the Riemann sum against the physical integrator on the dense scene.
-# Embedded in the library (volume_report_plot_py.h) and run as `python3 - DIR` with this text on
-# stdin: reads DIR/volume-report.csv, writes DIR/volume-report.png. Exit code 3: matplotlib is missing.
-import csv
-import math
-import os
-import sys
-
-try:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-except ImportError:
-    sys.stderr.write("matplotlib is missing\n")
-    sys.exit(3)
-
+# Embedded in the library (volume_report_plot_py.h) and run after plot_common.py's text as
+# `python3 - DIR`: reads DIR/volume-report.csv, writes DIR/volume-report.png.
 FLOOR = 1e-9  # zero errors are drawn here on the log axis
 
-folder = sys.argv[1]
-with open(os.path.join(folder, "volume-report.csv"), newline="") as f:
-    rows = list(csv.DictReader(f))
-scenes = []
-for r in rows:
-    if r["scene"] not in scenes:
-        scenes.append(r["scene"])
+rows, scenes = read_rows("volume-report.csv")
 
 # Colour: resolution and upsampling; marker: integrator; filled: rgba32f, hollow: rgba16f.
 COLOR = {
@@ -38,10 +19,7 @@ FRONT = {"stylized": "black", "physical": "tab:red"}
 
 
 def err(value):
-    v = float(value)
-    if math.isnan(v) or math.isinf(v):
-        return None
-    return max(v, FLOOR)
+    return clipped_error(value, FLOOR)
 
 
 def label_of(r):
@@ -71,11 +49,7 @@ for i, scene in enumerate(scenes):
         legend.setdefault(label_of(r), h)
         fronts.setdefault(r["integrator"], []).append((t, e))
     for integrator, pts in fronts.items():
-        front, best = [], float("inf")
-        for t, e in sorted(pts):
-            if e < best:
-                front.append((t, e))
-                best = e
+        front = pareto_front(pts)
         if len(front) > 1:
             h, = ax.plot([p[0] for p in front], [p[1] for p in front], color=FRONT.get(integrator, "gray"),
                          lw=0.9, ls="--", zorder=0)
@@ -124,11 +98,7 @@ if len(panels) < nrows * cols:
             color = COLOR.get((res, up), "gray")
             ax.scatter([t], [e], s=18, marker=MARKER[integrator], color=color, alpha=0.75)
             pts.append((t, e))
-        front, best = [], float("inf")
-        for t, e in sorted(pts):
-            if e < best:
-                front.append((t, e))
-                best = e
+        front = pareto_front(pts)
         if len(front) > 1:
             ax.plot([p[0] for p in front], [p[1] for p in front], color=FRONT[integrator], lw=0.9, ls="--", zorder=0)
     ax.set_xscale("log")
@@ -142,6 +112,4 @@ for j in range(len(panels), nrows * cols):
 fig.legend(list(legend.values()), list(legend.keys()), loc="lower center", ncol=4, fontsize=8, frameon=False)
 fig.suptitle("fogcl volumetric pass: error against run time (filled: rgba32f, hollow: rgba16f)")
 fig.tight_layout(rect=(0, 0.07, 1, 0.96))
-tmp = os.path.join(folder, ".volume-report.png.tmp")
-fig.savefig(tmp, dpi=100, format="png")
-os.replace(tmp, os.path.join(folder, "volume-report.png"))
+save_png(fig, "volume-report.png", 100)

@@ -18,6 +18,8 @@
 #include "fogcl/version.h"
 #include "runtime/clhpp.h"
 
+#include "plot_common_py.h"  // generated from report/plot_common.py
+
 namespace fogcl::report_detail {
 
 namespace fs = std::filesystem;
@@ -125,7 +127,8 @@ void run_plot_script(const std::string& dir, const std::string& python, const ch
   const std::string cmd = python + " - " + quoted;
   FILE* p = ::popen(cmd.c_str(), "w");
   if (p == nullptr) throw Error("cannot draw " + png + ": cannot run " + python);
-  const bool sent = std::fwrite(script, 1, n, p) == n;
+  const std::size_t common = sizeof(plot_common_py) - 1;
+  const bool sent = std::fwrite(plot_common_py, 1, common, p) == common && std::fwrite(script, 1, n, p) == n;
   const int status = ::pclose(p);
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (code == 3) throw Error("cannot draw " + png + ": matplotlib is missing for " + python + "; " + install);

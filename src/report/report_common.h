@@ -53,8 +53,8 @@ std::string json_string(const std::string& s);
 // Writes `text` to `path` through a temporary file and a rename. Throws fogcl::Error.
 void write_file(const std::string& path, const std::string& text);
 
-// Runs `python` with `script` on its stdin and `dir` as argv[1]; `png` names the picture for
-// the messages. Exit code 3 of the script means "matplotlib is missing". Throws fogcl::Error
+// Runs `python` with plot_common.py's text and then `script` on its stdin, `dir` as argv[1];
+// `png` names the picture for the messages. Exit code 3 of the script means "matplotlib is missing". Throws fogcl::Error
 // with one line saying what to install, or what failed.
 void run_plot_script(const std::string& dir, const std::string& python, const char* script, std::size_t script_size,
                      const std::string& png);
