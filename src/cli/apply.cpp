@@ -226,15 +226,21 @@ struct Devices {
   explicit Devices(const ApplyOptions& o) : backend(o.device), volumes(VolumeStage::create(o.volumes, backend.runtime())) {}
 };
 
-// Opens the devices into `result` (its value, or the exception that stopped them).
-void open_devices(const ApplyOptions& o, std::promise<std::unique_ptr<Devices>>& result) {
+// Opens the devices into `result` (its value, or the exception that stopped them); returns that
+// exception's message, "" when they opened.
+std::string open_devices(const ApplyOptions& o, std::promise<std::shared_ptr<Devices>>& result) {
   try {
     const auto start = std::chrono::steady_clock::now();
-    auto devices = std::make_unique<Devices>(o);
+    auto devices = std::make_shared<Devices>(o);
     devices->open_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.set_value(std::move(devices));
+    return "";
+  } catch (const std::exception& e) {
+    result.set_exception(std::current_exception());
+    return e.what();
   } catch (...) {
     result.set_exception(std::current_exception());
+    return "the device failed to open (unknown error)";
   }
 }
 
@@ -376,10 +382,10 @@ int run_apply(const ApplyOptions& o) {
     FrameJob job;
     job.paths = {o.color_path, o.depth_path, o.out_path, o.png_path};
     std::future<void> reading = std::async(std::launch::async, [&] { read_frame(o, job); });
-    std::promise<std::unique_ptr<Devices>> opened;
+    std::promise<std::shared_ptr<Devices>> opened;
     open_devices(o, opened);
     reading.get();  // a bad input is named whether or not the device opened
-    const std::unique_ptr<Devices> devices = opened.get_future().get();
+    const std::shared_ptr<Devices> devices = opened.get_future().get();
     fog_frame(o, devices->backend, job, o.verbose, devices->volumes.get(), -1);
     take_inputs(job);
     write_frame(o, job);
@@ -397,11 +403,10 @@ int run_apply(const ApplyOptions& o) {
   // One device, one context, one program cache for every frame: opened by the pipeline's start
   // (this thread), taken by the fog stage at its first frame. A device that fails to open stops
   // the run (not a frame failure).
-  std::promise<std::unique_ptr<Devices>> opened;
-  std::future<std::unique_ptr<Devices>> opening = opened.get_future();
-  std::unique_ptr<Devices> devices;
-  std::string device_error;  // the fog thread writes it, done() reads it for any frame: guarded
-  std::mutex device_mutex;
+  std::promise<std::shared_ptr<Devices>> opened;
+  const std::shared_future<std::shared_ptr<Devices>> opening = opened.get_future();
+  std::shared_ptr<Devices> devices;  // the fog thread's
+  std::string device_error;          // this thread's: start() sets it before done() first runs
   if (o.verbose) {
     std::fprintf(stderr, "threads: %d (OpenEXR (de)compression%s)\n", threads,
                  resolve_device_choice(o.device) == "scalar" ? "" : "; PoCL's POCL_MAX_PTHREAD_COUNT unless set");
@@ -426,18 +431,9 @@ int run_apply(const ApplyOptions& o) {
     InputFrames spare = spare_inputs.take();
     read_frame(o, job, &spare);
   };
-  stages.start = [&] { open_devices(o, opened); };
+  stages.start = [&] { device_error = open_devices(o, opened); };
   stages.fog = [&](FrameJob& job) {
-    if (!devices) {
-      std::lock_guard<std::mutex> lock(device_mutex);
-      if (!device_error.empty()) throw Error(device_error);
-      try {
-        devices = opening.get();
-      } catch (const std::exception& e) {
-        device_error = e.what();
-        throw;
-      }
-    }
+    if (!devices) devices = opening.get();  // waits for start(); rethrows what stopped the opening
     job.out = spares.take();  // the passes reuse it when it has the frame's size and storage
     const auto start = std::chrono::steady_clock::now();
     fog_frame(o, devices->backend, job, o.verbose && !setup_printed, devices->volumes.get(), job.frame);
@@ -453,12 +449,9 @@ int run_apply(const ApplyOptions& o) {
     spares.give(std::move(job.out));
   };
   stages.done = [&](const FrameJob& job) {
-    {
-      std::lock_guard<std::mutex> lock(device_mutex);
-      if (!device_error.empty()) {
-        stop_error = device_error;
-        return false;
-      }
+    if (!device_error.empty()) {
+      stop_error = device_error;
+      return false;
     }
     if (!job.error.empty()) {
       progress.clear();
