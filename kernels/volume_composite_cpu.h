@@ -17,12 +17,15 @@
  * Rows whose window reaches past the target's edges load it column by column, clamped. */
 
 #ifdef __clang__
-/* 16 words at 4-byte alignment, moved by one unaligned vector instruction (as in fog_cpu_blocks.h:
- * PoCL splits vstore16). */
+/* 16 words (halfwords) at 4-byte (2-byte) alignment, moved by one unaligned vector instruction (as
+ * in fog_cpu_blocks.h: PoCL splits vstore16, into 16 scalar stores for ushort16). */
 typedef uint vol_v16u_u __attribute__((__vector_size__(64), aligned(4)));
+typedef ushort vol_v16h_u __attribute__((__vector_size__(32), aligned(2)));
 #define VOL_STORE16U(value, p) (*(global vol_v16u_u*)(p) = __builtin_bit_cast(vol_v16u_u, (value)))
+#define VOL_STORE16H(value, p) (*(global vol_v16h_u*)(p) = __builtin_bit_cast(vol_v16h_u, (value)))
 #else
 #define VOL_STORE16U(value, p) vstore16((value), 0, (p))
+#define VOL_STORE16H(value, p) vstore16((value), 0, (p))
 #endif
 
 #define VOL_LANE_INDEX (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
@@ -61,11 +64,16 @@ static inline float16 vol_eye_depth_v(float16 raw, float zx, float zy, float nea
 #endif
 }
 
-/* vol_depth_difference (volume_composite.h) lane-wise: the same operations, selects for its
- * branches (equal depths 0, sky against a surface 1). */
-static inline float16 vol_depth_difference_v(float16 a, float16 b) {
+/* 1 / k for the keys of volume_composite.h's vol_depth_difference: fmax(k, 0) + 0 makes -0, NaN
+ * and negative keys +0 (reciprocal +inf), which the fmin below then never picks over a key > 0. */
+static inline float16 vol_key_reciprocal_v(float16 k) { return 1.0f / (fmax(k, 0.0f) + 0.0f); }
+
+/* vol_depth_difference (volume_composite.h) lane-wise, given ra = 1 / a and rb = 1 / b from
+ * vol_key_reciprocal_v: fmin(ra, rb) is 1 / max(a, b) rounded, as that function computes it. The
+ * same operations otherwise, selects for its branches (equal depths 0, sky against a surface 1). */
+static inline float16 vol_depth_difference_v(float16 a, float16 b, float16 ra, float16 rb) {
   const float16 hi = fmax(a, b), lo = fmin(a, b);
-  const float16 d = select((hi - lo) / hi, (float16)1.0f, !(hi < INFINITY));
+  const float16 d = select(fmin((hi - lo) * fmin(ra, rb), 1.0f), (float16)1.0f, !(hi < INFINITY));
   return select(d, (float16)0.0f, hi == lo);
 }
 
@@ -110,7 +118,7 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
   vstore_half16_rte(o, 0, (half*)staged);
   const ushort16 rounded = vload16(0, staged);
 #endif
-  vstore16(select(rounded, bits, convert_short16(keep)), q, (global ushort*)out);
+  VOL_STORE16H(select(rounded, bits, convert_short16(keep)), (global ushort*)out + 16 * q);
 #else
   const uint16 bits = vload16(q, (global const uint*)in);
   const float16 c = as_float16(bits);
@@ -139,16 +147,29 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   const size_t top = (size_t)y0 * (size_t)low_width, bottom = (size_t)y1 * (size_t)low_width;
   float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
 #if VOL_DEPTH_AWARE
+  /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), then one
+   * reciprocal of their sum per pixel. */
   const float16 key = vol_eye_depth_v(vload16(0, depth + i0), frame[VOL_F_ZX], frame[VOL_F_ZY],
                                       frame[VOL_F_NEAR], frame[VOL_F_FAR]);
   const float16 top_keys = vol_window_keys(low_key, top, b, low_width, inside);
   const float16 bottom_keys = vol_window_keys(low_key, bottom, b, low_width, inside);
-  w0 = w0 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(top_keys, VOL_LEFT_TAP)));
-  w1 = w1 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(top_keys, VOL_RIGHT_TAP)));
-  w2 = w2 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(bottom_keys, VOL_LEFT_TAP)));
-  w3 = w3 / (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(bottom_keys, VOL_RIGHT_TAP)));
+  const float16 r_key = vol_key_reciprocal_v(key), r_top = vol_key_reciprocal_v(top_keys),
+                r_bottom = vol_key_reciprocal_v(bottom_keys);
+#define VOL_E(keys, r, tap) \
+  (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(keys, tap), r_key, shuffle(r, tap)))
+  const float16 e0 = VOL_E(top_keys, r_top, VOL_LEFT_TAP), e1 = VOL_E(top_keys, r_top, VOL_RIGHT_TAP),
+                e2 = VOL_E(bottom_keys, r_bottom, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, r_bottom, VOL_RIGHT_TAP);
+#undef VOL_E
+  const float16 e01 = e0 * e1, e23 = e2 * e3;
+  w0 = w0 * (e1 * e23);
+  w1 = w1 * (e0 * e23);
+  w2 = w2 * (e3 * e01);
+  w3 = w3 * (e2 * e01);
+  const float16 norm = 1.0f / (0.0f + w0 + w1 + w2 + w3);
+#define VOL_NORMALISE(sum, q) ((sum) * VOL_QUAD_SPREAD(norm, q))
+#else
+#define VOL_NORMALISE(sum, q) (sum) /* the bilinear weights sum to exactly 1 */
 #endif
-  const float16 weight = 0.0f + w0 + w1 + w2 + w3;
 #define VOL_QUAD(q)                                                                                      \
   {                                                                                                      \
     const int c = b + 4 * q / VOL_SCALE;                                                                 \
@@ -158,13 +179,14 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
                         shuffle(t, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w1, q) +                            \
                         shuffle(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q) +                             \
                         shuffle(u, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w3, q);                             \
-    vol_composite_quad(in, out, q, sum / VOL_QUAD_SPREAD(weight, q));                                    \
+    vol_composite_quad(in, out, q, VOL_NORMALISE(sum, q));                                               \
   }
   VOL_QUAD(0)
   VOL_QUAD(1)
   VOL_QUAD(2)
   VOL_QUAD(3)
 #undef VOL_QUAD
+#undef VOL_NORMALISE
 #endif
 }
 
