@@ -2,6 +2,7 @@
 // interrupts), the progress bar's rate and ETA, --pixel-type / --compression / --threads, and
 // outputs that a killed run (SIGKILL mid-write, SIGINT) never leaves partial or as temporaries.
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -462,13 +463,31 @@ TierSplit tier_split(const std::string& output) {
   return split;
 }
 
-bool tiering_applies() { return runtime() != nullptr && cli_device() == "cpu" && device_is_pocl_cpu(runtime()->device()); }
+// The cores this process may run on, as `fogcl apply` counts them.
+std::vector<int> allowed_cores() {
+  cpu_set_t set;
+  std::vector<int> cores;
+  if (sched_getaffinity(0, sizeof set, &set) == 0)
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &set)) cores.push_back(c);
+  return cores;
+}
+
+bool tiering_applies() {
+  return runtime() != nullptr && cli_device() == "cpu" && device_is_pocl_cpu(runtime()->device()) &&
+         allowed_cores().size() > 1;
+}
+#define SKIP_UNLESS_TIERING()                                                                          \
+  if (!tiering_applies())                                                                             \
+  GTEST_SKIP() << "tiering is PoCL's CPU device's, with more than one core (FOGCL_DEVICE=" << cli_device() \
+               << ", " << allowed_cores().size() << " core(s))"
+
 
 // A tiered run (PoCL's CPU device, the default) fogs its first frames on the scalar path and the
 // rest on the device: its files are those of a run on the device alone (FOGCL_TIERING=off) and
 // of one on the scalar path alone, byte for byte, and --verbose counts the scalar frames.
 TEST_F(Sequence, TieredRunWritesTheBytesOfDeviceOnlyAndScalarOnlyRuns) {
-  if (!tiering_applies()) GTEST_SKIP() << "tiering is PoCL's CPU device's (FOGCL_DEVICE=" << cli_device() << ")";
+  SKIP_UNLESS_TIERING();
   // Frames slow enough (one thread) that the device, opening in 0.1-0.4 s, takes over midway.
   const int n = 16;
   make_frames(n, 640, 360);
@@ -503,13 +522,20 @@ TEST_F(Sequence, TieredRunWritesTheBytesOfDeviceOnlyAndScalarOnlyRuns) {
   EXPECT_NE(bad.output.find("FOGCL_TIERING must be on or off (got 'maybe')"), std::string::npos) << bad.output;
 }
 
-// Only PoCL's CPU kernel gives the scalar path's bits: a GPU, a device named by text, --precision
-// fast and --volumes wait for the device as before.
-TEST_F(Sequence, TieringIsOnlyForPoclsCpuDeviceAtThePrecisePrecision) {
-  if (!tiering_applies()) GTEST_SKIP() << "tiering is PoCL's CPU device's (FOGCL_DEVICE=" << cli_device() << ")";
+// Only PoCL's CPU kernel gives the scalar path's bits: a device named by text and --precision fast
+// wait for the device as before (and so do a GPU and --volumes). So does a run on one core, where
+// nothing overlaps the opening.
+TEST_F(Sequence, TieringIsOnlyForPoclsCpuDeviceAtThePrecisePrecisionOnSeveralCores) {
+  SKIP_UNLESS_TIERING();
   make_frames(2, 16, 9);
-  for (const char* extra : {" --device pthread", " --device cpu --precision fast", " --device scalar"}) {
-    const CliRun r = run_cli(inputs() + extra + " --verbose --out " + path("out/o.####.exr"));
+  const std::string one_core = "taskset -c " + std::to_string(allowed_cores().front());
+  const struct {
+    const char* extra;
+    std::string env;
+  } runs[] = {{" --device pthread", ""}, {" --device cpu --precision fast", ""}, {" --device scalar", ""},
+              {" --device cpu", one_core}};
+  for (const auto& [extra, env] : runs) {
+    const CliRun r = run_cli(inputs() + extra + " --verbose --out " + path("out/o.####.exr"), env);
     ASSERT_EQ(r.exit_code, 0) << extra << ": " << r.output;
     EXPECT_EQ(r.output.find("tiering"), std::string::npos) << extra << ": " << r.output;
     EXPECT_EQ(tier_split(r.output).scalar_frames, 0) << extra << ": " << r.output;
@@ -521,7 +547,7 @@ TEST_F(Sequence, TieringIsOnlyForPoclsCpuDeviceAtThePrecisePrecision) {
 // frames written before it stay (complete, the bits PoCL's kernel would give), and the line says
 // how many; none when the failure came first.
 TEST_F(Sequence, ADeviceThatFailsToOpenAfterTieredFramesStillFailsTheRun) {
-  if (!tiering_applies()) GTEST_SKIP() << "tiering is PoCL's CPU device's (FOGCL_DEVICE=" << cli_device() << ")";
+  SKIP_UNLESS_TIERING();
   const int n = 40;
   make_frames(n, 64, 36);
   const CliRun scalar = run_cli(inputs() + " --device scalar --out " + path("out/scalar.####.exr"));

@@ -243,14 +243,17 @@ struct Devices {
 // the device takes over from the first frame after it has opened. Not with --volumes (the scalar
 // march takes seconds a frame), --precision fast or --max-error (kernel variants the scalar path
 // does not have), nor for a GPU or a device named by text, whose bits differ or are not known
-// before it has opened. FOGCL_TIERING=off turns it off: every frame waits for the device and runs
-// on it (to measure or exercise the device; the tests compare both ways).
-bool tiers(const ApplyOptions& o) {
+// before it has opened. Nor on a single core: nothing overlaps there, so a frame fogged on the
+// scalar path only adds its cost over the kernel's (~45 ms a 1080p half frame on the 2-core
+// machine) to the run, which opening PoCL first and waiting for it does not. FOGCL_TIERING=off
+// turns it off: every frame waits for the device and runs on it (to measure or exercise the
+// device; the tests compare both ways).
+bool tiers(const ApplyOptions& o, int cores) {
   const char* env = std::getenv("FOGCL_TIERING");
   const std::string choice = env == nullptr ? "" : env;
   if (choice != "" && choice != "on" && choice != "off")
     throw Error("FOGCL_TIERING must be on or off (got '" + choice + "')");
-  return choice != "off" && o.volumes.volumes_path.empty() && !o.max_error_given &&
+  return choice != "off" && cores > 1 && o.volumes.volumes_path.empty() && !o.max_error_given &&
          o.settings.precision == Precision::precise && resolve_device_choice(o.device) == "cpu";
 }
 
@@ -450,7 +453,7 @@ int run_apply(const ApplyOptions& o) {
   // One device, one context, one program cache for every frame: opened by the pipeline's start
   // (this thread) while the first frames go through, taken by the fog stage when it needs it
   // (tiered: once it has opened). A device that fails to open stops the run (not a frame failure).
-  const bool tiered = tiers(o);
+  const bool tiered = tiers(o, available_cores());
   std::promise<std::shared_ptr<Devices>> opened;
   const std::shared_future<std::shared_ptr<Devices>> opening = opened.get_future();
   std::string device_error;  // this thread's (start() runs here)
