@@ -605,11 +605,13 @@ int run_apply(const ApplyOptions& o) {
     return 1;
   }
   if (o.verbose) {
+    // The device opened (device_error is empty); tiered, its builds may all be the main thread's.
+    Backend& device = opening.get()->backend;
     if (scalar_frames > 0 && !devices)
       std::fprintf(stderr, "start-up: device opened in %.3f s, after the last frame: all %d frames were fogged on "
                    "the scalar path\n", opening.get()->open_s, scalar_frames);
     std::fprintf(stderr, "fogged %zu frames, %zu program build(s)\n", frames.size(),
-                 !devices || devices->backend.is_scalar() ? std::size_t(0) : devices->backend.pass()->programs().builds());
+                 device.is_scalar() ? std::size_t(0) : device.pass()->programs().builds());
     // Where the time went: the stages overlap, so the busiest one bounds the frame rate.
     const double n = double(std::max(outcome.finished, 1));
     std::fprintf(stderr, "stages per frame: read %.3f s, fog %.3f s, write %.3f s; wall %.3f s (%.2f frames/s)\n",
