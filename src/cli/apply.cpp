@@ -219,9 +219,10 @@ class Spares {
 
 // The device and the volume stage of a run. Opening a PoCL device loads its LLVM libraries:
 // 0.2-0.35 s a process on the 16-core machine (bench/results/device-16core-startup), a quarter of
-// a 12-frame 4K sequence at 16 threads. So the first frame is read meanwhile. The device opens on
-// the main thread, which lives as long as the process: LLVM gives the thread that initialises it
-// an alternate signal stack of its own, which a thread's exit then fails to release (ASan aborts).
+// a 12-frame 4K sequence at 16 threads. So frames are read meanwhile (and fogged and written when
+// tiered, below). The device opens on the main thread, which lives as long as the process: LLVM
+// gives the thread that initialises it an alternate signal stack of its own, which a thread's exit
+// then fails to release (ASan aborts).
 struct Devices {
   Backend backend;
   std::unique_ptr<VolumeStage> volumes;
