@@ -508,7 +508,8 @@ TEST_F(Sequence, TieredRunWritesTheBytesOfDeviceOnlyAndScalarOnlyRuns) {
   EXPECT_EQ(split.first_on_device, split.scalar_frames + 1) << "the device takes over midway: " << tiered.output;
   EXPECT_EQ(device.output.find("tiering"), std::string::npos) << device.output;
   EXPECT_EQ(tier_split(device.output).scalar_frames, 0) << device.output;
-  EXPECT_NE(device.output.find("device: pthread"), std::string::npos) << "the first frame on the device: " << device.output;
+  EXPECT_NE(device.output.find("device: " + device_name(runtime()->device())), std::string::npos)
+      << "the first frame on the device: " << device.output;
 
   for (int f = 1; f <= n; ++f) {
     const std::vector<char> bytes = file_bytes(path("out/" + frame_name("tiered", f)));
@@ -523,8 +524,8 @@ TEST_F(Sequence, TieredRunWritesTheBytesOfDeviceOnlyAndScalarOnlyRuns) {
 }
 
 // Only PoCL's CPU kernel gives the scalar path's bits: a device named by text and --precision fast
-// wait for the device as before (and so do a GPU and --volumes). So does a run on one core, where
-// nothing overlaps the opening.
+// wait for the device as before (tiers() leaves out a GPU and --volumes the same way). So does a
+// run on one core, where nothing overlaps the opening.
 TEST_F(Sequence, TieringIsOnlyForPoclsCpuDeviceAtThePrecisePrecisionOnSeveralCores) {
   SKIP_UNLESS_TIERING();
   make_frames(2, 16, 9);
@@ -532,7 +533,7 @@ TEST_F(Sequence, TieringIsOnlyForPoclsCpuDeviceAtThePrecisePrecisionOnSeveralCor
   const struct {
     const char* extra;
     std::string env;
-  } runs[] = {{" --device pthread", ""}, {" --device cpu --precision fast", ""}, {" --device scalar", ""},
+  } runs[] = {{" --device portable", ""},  // PoCL's platform name: a device named by text {" --device cpu --precision fast", ""}, {" --device scalar", ""},
               {" --device cpu", one_core}};
   for (const auto& [extra, env] : runs) {
     const CliRun r = run_cli(inputs() + extra + " --verbose --out " + path("out/o.####.exr"), env);
