@@ -3,7 +3,8 @@
 // builtins (fog_cpu_avx512.h: a real-valued exp2 reduction, vscalefps) and without them (the
 // portable OpenCL C path). The probe frame (color 1, fog color 0) makes each output channel equal
 // to f. Densities are chosen so that exp2's argument covers its whole domain, including the flush
-// below -126 and beyond.
+// below -126 and beyond. KernelOutputBits then checks the whole output (blend, half storage,
+// every projection), which `fogcl apply`'s tiering relies on.
 #include <cmath>
 #include <cstring>
 #include <vector>
@@ -109,6 +110,108 @@ TEST_P(KernelFactorBits, EqualTheScalarPathBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Variants, KernelFactorBits, testing::ValuesIn(all_cases()), name_of);
+
+// The whole output, not only the factor: `fogcl apply` fogs the frames that reach its fog stage
+// before PoCL has opened on the scalar path and the rest on the CPU kernel (tiering, apply.cpp),
+// which is only right if every byte of the blend (HDR colors, a fog color, half storage, alpha,
+// sky) is the same on both. Every mode, metric, sky choice and projection, in both storages, with
+// the target's builtins and without.
+struct OutputCase {
+  FogMode mode;
+  FogMetric metric;
+  bool fog_skybox;
+  Projection projection;
+  bool reversed;
+  ColorFormat format;
+};
+
+std::string output_case_name(const testing::TestParamInfo<OutputCase>& info) {
+  const OutputCase& c = info.param;
+  std::string n = to_string(c.mode);
+  n += c.metric == FogMetric::distance ? "_distance" : "_depth";
+  n += c.fog_skybox ? "_fogsky" : "_skytest";
+  n += c.projection == Projection::orthographic                ? "_ortho"
+       : c.projection == Projection::perspective_infinite_far ? "_infinitefar"
+                                                               : "_persp";
+  n += c.reversed ? "_reversed" : "_conventional";
+  n += std::string("_") + to_string(c.format);
+  return n;
+}
+
+std::vector<OutputCase> output_cases() {
+  std::vector<OutputCase> cases;
+  for (ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f})
+    for (FogMode mode : {FogMode::linear, FogMode::exp, FogMode::exp2})
+      for (FogMetric metric : {FogMetric::depth, FogMetric::distance}) {
+        // Each feature once against the plain case: the sky test, reversed Z, each projection.
+        cases.push_back({mode, metric, false, Projection::perspective, false, format});
+        cases.push_back({mode, metric, true, Projection::perspective, true, format});
+        cases.push_back({mode, metric, false, Projection::orthographic, false, format});
+        cases.push_back({mode, metric, false, Projection::perspective_infinite_far, true, format});
+      }
+  return cases;
+}
+
+class KernelOutputBits : public testing::TestWithParam<OutputCase> {
+ protected:
+  void SetUp() override {
+    FOGCL_REQUIRE_DEVICE();
+    if (!runtime()->is_cpu())
+      GTEST_SKIP() << "bit identity with the scalar path is the CPU kernel's (GPU divisions may round differently)";
+  }
+};
+
+TEST_P(KernelOutputBits, EqualTheScalarPathBitForBit) {
+  const OutputCase& c = GetParam();
+  const TestFrame t = make_test_frame(517, 23, c.reversed, c.format, 5);
+  CameraParams params = t.params;
+  if (c.projection == Projection::orthographic) {
+    OrthographicCamera ortho;
+    ortho.aspect = t.camera.aspect;
+    ortho.near_plane = t.camera.near_plane;
+    ortho.far_plane = t.camera.far_plane;
+    params = make_camera_params(ortho);
+  } else if (c.projection == Projection::perspective_infinite_far) {
+    PerspectiveCamera infinite = t.camera;
+    infinite.infinite_far = true;
+    params = make_camera_params(infinite);
+  }
+  FogSettings s;
+  s.mode = c.mode;
+  s.metric = c.metric;
+  s.fog_skybox = c.fog_skybox;
+  s.color = glm::vec3(0.6f, 0.7f, 0.8f);
+  s.start = 2.0f;
+  s.end = 400.0f;
+  s.density = 0.01f;
+
+  ColorImage scalar, target, portable;
+  apply_fog_scalar(t.color, t.depth, scalar, params, s);
+  shared_pass().apply(t.color, t.depth, target, params, s);
+  CpuCodegen plain;
+  plain.target_intrinsics = false;
+  FogPass portable_pass(*runtime(), plain);
+  portable_pass.apply(t.color, t.depth, portable, params, s);
+
+  // Bytes, so that NaN payloads and -0 count too.
+  const auto bytes_off = [&](const ColorImage& got) {
+    std::size_t off = 0;
+    for (std::size_t i = 0; i < got.size_bytes(); ++i)
+      off += static_cast<const unsigned char*>(got.data())[i] != static_cast<const unsigned char*>(scalar.data())[i];
+    return off;
+  };
+  std::size_t changed = 0;  // bytes the fog changed: the comparison covers the blend
+  for (std::size_t i = 0; i < scalar.size_bytes(); ++i)
+    changed += static_cast<const unsigned char*>(scalar.data())[i] != static_cast<const unsigned char*>(t.color.data())[i];
+  const std::size_t target_off = bytes_off(target), portable_off = bytes_off(portable);
+  std::printf("[ worst    ] %s: bytes off the scalar path: target %zu, portable %zu (of %zu, %zu fogged)\n",
+              output_case_name({c, 0}).c_str(), target_off, portable_off, scalar.size_bytes(), changed);
+  EXPECT_EQ(target_off, 0u);
+  EXPECT_EQ(portable_off, 0u);
+  EXPECT_GT(changed, scalar.size_bytes() / 8);
+}
+
+INSTANTIATE_TEST_SUITE_P(Variants, KernelOutputBits, testing::ValuesIn(output_cases()), output_case_name);
 
 }  // namespace
 }  // namespace fogcl::test

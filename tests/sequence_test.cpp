@@ -2,6 +2,7 @@
 // interrupts), the progress bar's rate and ETA, --pixel-type / --compression / --threads, and
 // outputs that a killed run (SIGKILL mid-write, SIGINT) never leaves partial or as temporaries.
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -15,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <thread>
 #include <vector>
 
@@ -104,31 +106,36 @@ TEST(FramePipeline, ReportsEachStagesBusyTime) {
   EXPECT_LT(outcome.total_s, outcome.read_s + outcome.write_s);  // reading overlaps writing
 }
 
-// Stages::start: once, on the caller's thread, while the reader already reads, before any write
-// (apply.cpp opens the device there).
-TEST(FramePipeline, StartRunsOnceOnTheCallersThreadBeforeTheFirstWrite) {
+// Stages::start: once, on the caller's thread, while frames are read, fogged and written (apply.cpp
+// opens the device there and fogs the first frames on the scalar path meanwhile); run() returns
+// after both.
+TEST(FramePipeline, StartRunsOnceOnTheCallersThreadWhileFramesAreWritten) {
   FramePipeline<FakeJob>::Stages s;
-  std::atomic<int> reads{0}, starts{0}, writes_before_start{0};
-  int reads_during_start = 0;
-  std::atomic<bool> started{false};
-  std::thread::id start_thread;
-  s.read = [&](FakeJob&) { ++reads; };
+  std::atomic<int> starts{0}, writes{0};
+  int writes_during_start = 0;
+  std::atomic<bool> start_returned{false};
+  std::thread::id start_thread, write_thread;
+  s.read = [](FakeJob&) {};
   s.fog = [](FakeJob&) {};
-  s.write = [&](FakeJob&) { writes_before_start += !started; };
+  s.write = [&](FakeJob&) {
+    write_thread = std::this_thread::get_id();
+    ++writes;
+  };
   s.done = [](const FakeJob&) { return true; };
   s.start = [&] {
     ++starts;
     start_thread = std::this_thread::get_id();
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    reads_during_start = reads.load();
-    started = true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    writes_during_start = writes.load();
+    start_returned = true;
   };
   const auto outcome = FramePipeline<FakeJob>::run(range(1, 6), s, nullptr);
+  EXPECT_TRUE(start_returned.load());
   EXPECT_EQ(outcome.finished, 6);
   EXPECT_EQ(starts.load(), 1);
   EXPECT_EQ(start_thread, std::this_thread::get_id());
-  EXPECT_EQ(writes_before_start.load(), 0);
-  EXPECT_GE(reads_during_start, 1);  // the first read overlapped it
+  EXPECT_NE(write_thread, std::this_thread::get_id());
+  EXPECT_EQ(writes_during_start, 6);  // every frame went through while start() ran
 }
 
 TEST(FramePipeline, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
@@ -434,6 +441,140 @@ TEST_F(Sequence, ADeviceThatCannotOpenStopsTheRunWithOneError) {
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("missing.exr"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("no OpenCL device"), std::string::npos) << r.output;
+}
+
+// ---- Tiering: the first frames on the scalar path while PoCL opens ---------------------------------
+
+// The frames --verbose says were fogged on the scalar path while the device opened (0 when it
+// says nothing about it), and the first frame on the device (-1: none).
+struct TierSplit {
+  int scalar_frames = 0, first_on_device = -1;
+};
+TierSplit tier_split(const std::string& output) {
+  TierSplit split;
+  std::smatch m;
+  if (std::regex_search(output, m, std::regex(R"((\d+) frame\(s\) fogged on the scalar path meanwhile \(1-(\d+)\); from frame (\d+) on the device)"))) {
+    split.scalar_frames = std::stoi(m[1]);
+    EXPECT_EQ(std::stoi(m[2]), split.scalar_frames) << "the scalar frames are the first ones";
+    split.first_on_device = std::stoi(m[3]);
+  } else if (std::regex_search(output, m, std::regex(R"(all (\d+) frames were fogged on the scalar path)"))) {
+    split.scalar_frames = std::stoi(m[1]);
+  }
+  return split;
+}
+
+// The cores this process may run on, as `fogcl apply` counts them.
+std::vector<int> allowed_cores() {
+  cpu_set_t set;
+  std::vector<int> cores;
+  if (sched_getaffinity(0, sizeof set, &set) == 0)
+    for (int c = 0; c < CPU_SETSIZE; ++c)
+      if (CPU_ISSET(c, &set)) cores.push_back(c);
+  return cores;
+}
+
+bool tiering_applies() {
+  return runtime() != nullptr && cli_device() == "cpu" && device_is_pocl_cpu(runtime()->device()) &&
+         allowed_cores().size() > 1;
+}
+#define SKIP_UNLESS_TIERING()                                                                          \
+  if (!tiering_applies())                                                                             \
+  GTEST_SKIP() << "tiering is PoCL's CPU device's, with more than one core (FOGCL_DEVICE=" << cli_device() \
+               << ", " << allowed_cores().size() << " core(s))"
+
+
+// A tiered run (PoCL's CPU device, the default) fogs its first frames on the scalar path and the
+// rest on the device: its files are those of a run on the device alone (FOGCL_TIERING=off) and
+// of one on the scalar path alone, byte for byte, and --verbose counts the scalar frames.
+TEST_F(Sequence, TieredRunWritesTheBytesOfDeviceOnlyAndScalarOnlyRuns) {
+  SKIP_UNLESS_TIERING();
+  // Frames slow enough (one thread) that the device, opening in 0.1-0.4 s, takes over midway.
+  const int n = 16;
+  make_frames(n, 640, 360);
+  const std::string args = inputs() + " --distance --threads 1 --verbose";
+  const CliRun tiered = run_cli(args + " --device cpu --out " + path("out/tiered.####.exr"));
+  ASSERT_EQ(tiered.exit_code, 0) << tiered.output;
+  const CliRun device = run_cli(args + " --device cpu --out " + path("out/device.####.exr"), "FOGCL_TIERING=off");
+  ASSERT_EQ(device.exit_code, 0) << device.output;
+  const CliRun scalar = run_cli(args + " --device scalar --out " + path("out/scalar.####.exr"));
+  ASSERT_EQ(scalar.exit_code, 0) << scalar.output;
+
+  const TierSplit split = tier_split(tiered.output);
+  std::printf("[    split] %d of %d frames fogged on the scalar path, from frame %d on the device\n",
+              split.scalar_frames, n, split.first_on_device);
+  EXPECT_NE(tiered.output.find("tiering: frames that reach the fog stage while the device opens"), std::string::npos)
+      << tiered.output;
+  EXPECT_GT(split.scalar_frames, 0) << tiered.output;
+  EXPECT_EQ(split.first_on_device, split.scalar_frames + 1) << "the device takes over midway: " << tiered.output;
+  EXPECT_EQ(device.output.find("tiering"), std::string::npos) << device.output;
+  EXPECT_EQ(tier_split(device.output).scalar_frames, 0) << device.output;
+  EXPECT_NE(device.output.find("device: " + device_name(runtime()->device())), std::string::npos)
+      << "the first frame on the device: " << device.output;
+
+  for (int f = 1; f <= n; ++f) {
+    const std::vector<char> bytes = file_bytes(path("out/" + frame_name("tiered", f)));
+    ASSERT_FALSE(bytes.empty()) << f;
+    EXPECT_EQ(bytes, file_bytes(path("out/" + frame_name("device", f)))) << "frame " << f;
+    EXPECT_EQ(bytes, file_bytes(path("out/" + frame_name("scalar", f)))) << "frame " << f;
+  }
+
+  const CliRun bad = run_cli(inputs() + " --device cpu --out " + path("out/bad.####.exr"), "FOGCL_TIERING=maybe");
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("FOGCL_TIERING must be on or off (got 'maybe')"), std::string::npos) << bad.output;
+}
+
+// Only PoCL's CPU kernel gives the scalar path's bits: a device named by text and --precision fast
+// wait for the device as before (tiers() leaves out a GPU and --volumes the same way). So does a
+// run on one core, where nothing overlaps the opening.
+TEST_F(Sequence, TieringIsOnlyForPoclsCpuDeviceAtThePrecisePrecisionOnSeveralCores) {
+  SKIP_UNLESS_TIERING();
+  make_frames(2, 16, 9);
+  const std::string one_core = "taskset -c " + std::to_string(allowed_cores().front());
+  const struct {
+    const char* extra;
+    std::string env;
+  } runs[] = {{" --device portable", ""},  // PoCL's platform name: a device named by text {" --device cpu --precision fast", ""}, {" --device scalar", ""},
+              {" --device cpu", one_core}};
+  for (const auto& [extra, env] : runs) {
+    const CliRun r = run_cli(inputs() + extra + " --verbose --out " + path("out/o.####.exr"), env);
+    ASSERT_EQ(r.exit_code, 0) << extra << ": " << r.output;
+    EXPECT_EQ(r.output.find("tiering"), std::string::npos) << extra << ": " << r.output;
+    EXPECT_EQ(tier_split(r.output).scalar_frames, 0) << extra << ": " << r.output;
+  }
+}
+
+// A device that fails to open is one error for the run also when frames were fogged on the scalar
+// path meanwhile (here PoCL loads, then finds no device): exit 1, one line, nothing after it. The
+// frames written before it stay (complete, the bits PoCL's kernel would give), and the line says
+// how many; none when the failure came first.
+TEST_F(Sequence, ADeviceThatFailsToOpenAfterTieredFramesStillFailsTheRun) {
+  SKIP_UNLESS_TIERING();
+  const int n = 40;
+  make_frames(n, 64, 36);
+  const CliRun scalar = run_cli(inputs() + " --device scalar --out " + path("out/scalar.####.exr"));
+  ASSERT_EQ(scalar.exit_code, 0) << scalar.output;
+  for (const char* keep_going : {"", " --keep-going"}) {
+    for (int f = 1; f <= n; ++f) fs::remove(path("out/" + frame_name("o", f)));
+    const CliRun r = run_cli(inputs() + keep_going + " --device cpu --out " + path("out/o.####.exr"),
+                             "POCL_DEVICES=no-such-driver");
+    EXPECT_EQ(r.exit_code, 1) << keep_going << ": " << r.output;
+    EXPECT_NE(r.output.find("fogcl: error: no OpenCL device matches 'cpu'"), std::string::npos) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << keep_going << ": " << r.output;
+    int written = 0;
+    while (written < n && fs::exists(path("out/" + frame_name("o", written + 1)))) ++written;
+    std::printf("[  written] %d of %d frames before the device failed%s\n", written, n, keep_going);
+    for (int f = written + 1; f <= n; ++f) EXPECT_FALSE(fs::exists(path("out/" + frame_name("o", f)))) << f;
+    for (int f = 1; f <= written; ++f)
+      EXPECT_EQ(file_bytes(path("out/" + frame_name("o", f))), file_bytes(path("out/" + frame_name("scalar", f)))) << f;
+    if (written == 0) {
+      EXPECT_EQ(r.output.find("fogged on the scalar path"), std::string::npos) << r.output;
+    } else {
+      char says[160];
+      std::snprintf(says, sizeof says, "(the device failed to open after %d of %d frames were fogged on the scalar path "
+                    "and written, the last: frame %d)", written, n, written);
+      EXPECT_NE(r.output.find(says), std::string::npos) << r.output;
+    }
+  }
 }
 
 // ---- Killed runs -----------------------------------------------------------------------------------

@@ -12,7 +12,9 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <future>
+#include <optional>
 #include <limits>
 #include <mutex>
 #include <string>
@@ -131,6 +133,7 @@ FogSettings pass_settings(const ApplyOptions& o, Backend& backend, ColorFormat s
 struct FrameJob {
   int frame = 0;       // the frame number (0 for a single file)
   std::string error;   // what failed ("" = fine so far)
+  bool device_failed = false;  // error is the device's, which failed to open: it stops the run
   FramePaths paths;
   ExrInput color;      // its pixels are released once fogged; the rest describes the output
   DepthImage depth;    // raw device depth
@@ -216,23 +219,67 @@ class Spares {
 
 // The device and the volume stage of a run. Opening a PoCL device loads its LLVM libraries:
 // 0.2-0.35 s a process on the 16-core machine (bench/results/device-16core-startup), a quarter of
-// a 12-frame 4K sequence at 16 threads. So the first frame is read meanwhile. The device opens on
-// the main thread, which lives as long as the process: LLVM gives the thread that initialises it
-// an alternate signal stack of its own, which a thread's exit then fails to release (ASan aborts).
+// a 12-frame 4K sequence at 16 threads. So frames are read meanwhile (and fogged and written when
+// tiered, below). The device opens on the main thread, which lives as long as the process: LLVM
+// gives the thread that initialises it an alternate signal stack of its own, which a thread's exit
+// then fails to release (ASan aborts).
 struct Devices {
   Backend backend;
   std::unique_ptr<VolumeStage> volumes;
-  double open_s = 0;  // wall seconds the opening took (--verbose)
-  explicit Devices(const ApplyOptions& o) : backend(o.device), volumes(VolumeStage::create(o.volumes, backend.runtime())) {}
+  double open_s = 0;     // wall seconds the opening took (--verbose)
+  double prepare_s = -1;  // tiered: wall seconds of the first frame's program build (-1: none)
+  // Its kernel gives the scalar path's bits (PoCL's CPU device): it may take over from frames
+  // fogged on the scalar path (tiering, below).
+  bool scalar_bits;
+  explicit Devices(const ApplyOptions& o)
+      : backend(o.device),
+        volumes(VolumeStage::create(o.volumes, backend.runtime())),
+        scalar_bits(backend.runtime() != nullptr && device_is_pocl_cpu(backend.runtime()->device())) {}
 };
 
+// Tiering: PoCL takes 0.2-0.4 s to open (the dynamic loader relocating LLVM and clang), the
+// scalar path nothing, and at the precise precision the two give the same bits (KernelOutputBits
+// in tests/kernel_factor_bits_test.cpp). So in a sequence, frames that reach the fog stage while
+// PoCL's CPU device is opening are fogged on the scalar path (row bands on OpenEXR's pool), and
+// the device takes over from the first frame after it has opened. Not with --volumes (the scalar
+// march takes seconds a frame), --precision fast or --max-error (kernel variants the scalar path
+// does not have), nor for a GPU or a device named by text, whose bits differ or are not known
+// before it has opened. Nor on a single core: nothing overlaps there, so a frame fogged on the
+// scalar path only adds its cost over the kernel's (~45 ms a 1080p half frame on the 2-core
+// machine) to the run, which opening PoCL first and waiting for it does not. FOGCL_TIERING=off
+// turns it off: every frame waits for the device and runs on it (to measure or exercise the
+// device; the tests compare both ways).
+bool tiers(const ApplyOptions& o, int cores) {
+  const char* env = std::getenv("FOGCL_TIERING");
+  const std::string choice = env == nullptr ? "" : env;
+  if (choice != "" && choice != "on" && choice != "off")
+    throw Error("FOGCL_TIERING must be on or off (got '" + choice + "')");
+  return choice != "off" && cores > 1 && o.volumes.volumes_path.empty() && !o.max_error_given &&
+         o.settings.precision == Precision::precise && resolve_device_choice(o.device) == "cpu";
+}
+
 // Opens the devices into `result` (its value, or the exception that stopped them); returns that
-// exception's message, "" when they opened.
-std::string open_devices(const ApplyOptions& o, std::promise<std::shared_ptr<Devices>>& result) {
+// exception's message, "" when they opened. prepare (may be empty): builds programs before the
+// devices are handed over; its failures are left to the fog stage, which meets them again.
+std::string open_devices(const ApplyOptions& o, std::promise<std::shared_ptr<Devices>>& result,
+                         const std::function<void(Devices&)>& prepare = {}) {
   try {
-    const auto start = std::chrono::steady_clock::now();
+    auto start = std::chrono::steady_clock::now();
     auto devices = std::make_shared<Devices>(o);
-    devices->open_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const auto seconds_since = [&] {
+      const auto now = std::chrono::steady_clock::now();
+      const double s = std::chrono::duration<double>(now - start).count();
+      start = now;
+      return s;
+    };
+    devices->open_s = seconds_since();
+    if (prepare) {
+      try {
+        prepare(*devices);
+        devices->prepare_s = seconds_since();
+      } catch (const std::exception&) {
+      }
+    }
     result.set_value(std::move(devices));
     return "";
   } catch (const std::exception& e) {
@@ -242,6 +289,11 @@ std::string open_devices(const ApplyOptions& o, std::promise<std::shared_ptr<Dev
     result.set_exception(std::current_exception());
     return "the device failed to open (unknown error)";
   }
+}
+
+void print_build_options(Backend& backend, const Variant& variant) {
+  if (!backend.is_scalar() && variant.needs_pass())
+    std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
 }
 
 // The passes of one frame (fog thread; the only user of the backend and the volume stage).
@@ -277,8 +329,7 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
       std::fprintf(stderr, volumes != nullptr
                                ? "  why: no deferred fog pass (fog off or density 0): the output is the volumes' result\n"
                                : "  why: no pass runs (fog off or density 0): the output is the input\n");
-    if (!backend.is_scalar() && variant.needs_pass())
-      std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
+    print_build_options(backend, variant);
     std::fprintf(stderr, "output: %s, compression %s\n", o.pixel_type.c_str(),
                  o.compression.empty() ? (std::string(exr_compression_name(color.compression)) + " (the input's)").c_str()
                                        : o.compression.c_str());
@@ -401,15 +452,18 @@ int run_apply(const ApplyOptions& o) {
 
   const int swept = sweep_stale_temporaries(out) + (o.png_path.empty() ? 0 : sweep_stale_temporaries(png));
   // One device, one context, one program cache for every frame: opened by the pipeline's start
-  // (this thread), taken by the fog stage at its first frame. A device that fails to open stops
-  // the run (not a frame failure).
+  // (this thread) while the first frames go through, taken by the fog stage when it needs it
+  // (tiered: once it has opened). A device that fails to open stops the run (not a frame failure).
+  const bool tiered = tiers(o, available_cores());
   std::promise<std::shared_ptr<Devices>> opened;
   const std::shared_future<std::shared_ptr<Devices>> opening = opened.get_future();
-  std::shared_ptr<Devices> devices;  // the fog thread's
-  std::string device_error;          // this thread's: start() sets it before done() first runs
+  std::string device_error;  // this thread's (start() runs here)
   if (o.verbose) {
     std::fprintf(stderr, "threads: %d (OpenEXR (de)compression%s)\n", threads,
                  resolve_device_choice(o.device) == "scalar" ? "" : "; PoCL's POCL_MAX_PTHREAD_COUNT unless set");
+    if (tiered)
+      std::fprintf(stderr, "tiering: frames that reach the fog stage while the device opens are fogged on the scalar "
+                   "path (the same bits as PoCL's CPU kernel)\n");
     const std::filesystem::path out_dir = std::filesystem::path(out.prefix + "x").parent_path();
     std::fprintf(stderr, "temporary files: %s\n",
                  detail::temporary_file_kind(out_dir.empty() ? "." : out_dir.string()).c_str());
@@ -419,28 +473,88 @@ int run_apply(const ApplyOptions& o) {
   std::vector<std::string> failures;
   std::string stop_error;
   int written = 0, last_written = -1;
+
+  // The fog thread's.
+  std::shared_ptr<Devices> devices;  // once taken from `opening`
+  Backend scalar("scalar");          // tiered: the frames fogged before the device has opened
+  int scalar_frames = 0, first_scalar = -1, last_scalar = -1, device_frames = 0;
   bool setup_printed = false;
+  // Tiered frames were fogged on the scalar path but the device that opened is not PoCL's CPU
+  // device: its kernel's bits are not the scalar path's, so the run stays on the scalar path.
+  bool stay_scalar = false;
 
   Spares<ColorImage> spares;
   Spares<InputFrames> spare_inputs;
+  bool first_read = false;  // the reader's
+  // Tiered: the first frame's variant (nullopt: it failed to read), for the main thread's build.
+  std::promise<std::optional<Variant>> first_variant;
   FramePipeline<FrameJob>::Stages stages;
   stages.read = [&](FrameJob& job) {
     const int f = job.frame;
     job.paths = {frame_path(color, f), o.depth_path.empty() ? "" : frame_path(depth, f), frame_path(out, f),
                  o.png_path.empty() ? "" : frame_path(png, f)};
     InputFrames spare = spare_inputs.take();
-    read_frame(o, job, &spare);
+    const bool first = !first_read;
+    first_read = true;
+    try {
+      read_frame(o, job, &spare);
+    } catch (...) {
+      if (first && tiered) first_variant.set_value(std::nullopt);
+      throw;
+    }
+    if (first && tiered) first_variant.set_value(select_variant(o.settings, job.params, job.color.color.format()));
   };
-  stages.start = [&] { device_error = open_devices(o, opened); };
+  // Tiered, the first frame's program is built here too once the device has opened (0.09 s of
+  // PoCL's clang on the 2-core machine), while the fog stage goes on on the scalar path.
+  const auto prepare_first = [&](Devices& d) {
+    std::future<std::optional<Variant>> variant = first_variant.get_future();
+    while (variant.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready)
+      if (g_interrupt.load() != 0) return;  // the reader may stop before its first frame
+    if (const std::optional<Variant> v = variant.get(); v && d.backend.pass() != nullptr) d.backend.pass()->prepare(*v);
+  };
+  stages.start = [&] { device_error = tiered ? open_devices(o, opened, prepare_first) : open_devices(o, opened); };
   stages.fog = [&](FrameJob& job) {
-    if (!devices) devices = opening.get();  // waits for start(); rethrows what stopped the opening
+    // Tiered, the device is taken only once it has opened (never waited for); else it is waited for.
+    if (!devices && !stay_scalar &&
+        (!tiered || opening.wait_for(std::chrono::seconds(0)) == std::future_status::ready)) {
+      try {
+        devices = opening.get();  // rethrows what stopped the opening
+      } catch (...) {
+        job.device_failed = true;
+        throw;
+      }
+      if (scalar_frames > 0 && !devices->scalar_bits) {
+        stay_scalar = true;
+        std::fprintf(stderr, "fogcl: note: the device is %s, not PoCL's CPU device: its kernel's bits are not the "
+                     "scalar path's, so the frames after the %d fogged on the scalar path while it opened are "
+                     "fogged there too\n", devices->backend.name().c_str(), scalar_frames);
+      }
+    }
+    const bool on_device = devices && !stay_scalar;
+    if (!on_device) {
+      if (first_scalar < 0) first_scalar = job.frame;
+      last_scalar = job.frame;
+      ++scalar_frames;
+    }
+    Backend& backend = on_device ? devices->backend : scalar;
+    const bool first_on_device = on_device && device_frames++ == 0;
     job.out = spares.take();  // the passes reuse it when it has the frame's size and storage
     const auto start = std::chrono::steady_clock::now();
-    fog_frame(o, devices->backend, job, o.verbose && !setup_printed, devices->volumes.get(), job.frame);
-    if (o.verbose && !setup_printed)
-      std::fprintf(stderr, "start-up: device opened in %.3f s (while frame %d was read); "
-                   "frame %d's passes %.3f s (program builds included)\n", devices->open_s, job.frame, job.frame,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    fog_frame(o, backend, job, o.verbose && !setup_printed, on_device ? devices->volumes.get() : nullptr, job.frame);
+    const double passes_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (o.verbose && first_on_device) {
+      if (scalar_frames == 0)
+        std::fprintf(stderr, "start-up: device opened in %.3f s (while frame %d was read); "
+                     "frame %d's passes %.3f s (program builds included)\n", devices->open_s, job.frame, job.frame, passes_s);
+      else {
+        std::fprintf(stderr, "start-up: device %s opened in %.3f s, the first frame's program built in %.3f s on the "
+                     "main thread; %d frame(s) fogged on the scalar path meanwhile (%d-%d); from frame %d on the "
+                     "device: its passes %.3f s (program builds included)\n",
+                     backend.name().c_str(), devices->open_s, std::max(0.0, devices->prepare_s), scalar_frames,
+                     first_scalar, last_scalar, job.frame, passes_s);
+        print_build_options(backend, backend.pass()->last_variant());
+      }
+    }
     spare_inputs.give(take_inputs(job));
     setup_printed = true;
   };
@@ -449,10 +563,7 @@ int run_apply(const ApplyOptions& o) {
     spares.give(std::move(job.out));
   };
   stages.done = [&](const FrameJob& job) {
-    if (!device_error.empty()) {
-      stop_error = device_error;
-      return false;
-    }
+    if (job.device_failed) return false;  // the run's error (device_error), not the frame's
     if (!job.error.empty()) {
       progress.clear();
       if (!o.keep_going) {
@@ -471,6 +582,16 @@ int run_apply(const ApplyOptions& o) {
   g_interrupt = 0;
   catch_interrupts();
   const auto outcome = FramePipeline<FrameJob>::run(frames, stages, &g_interrupt);
+  // A device that fails to open is one error for the run whenever it fails, also after frames
+  // fogged on the scalar path meanwhile were written (tiered): those stay, complete and with the
+  // bits PoCL's CPU kernel gives, and the message says which.
+  if (!device_error.empty()) {
+    progress.clear();
+    throw Error(written == 0 ? device_error
+                             : device_error + " (the device failed to open after " + std::to_string(written) + " of " +
+                                   std::to_string(frames.size()) + " frames were fogged on the scalar path and "
+                                   "written, the last: frame " + std::to_string(last_written) + ")");
+  }
   if (!stop_error.empty()) throw Error(stop_error);
   progress.finish();
   if (outcome.interrupted) {
@@ -485,8 +606,13 @@ int run_apply(const ApplyOptions& o) {
     return 1;
   }
   if (o.verbose) {
+    // The device opened (device_error is empty); tiered, its builds may all be the main thread's.
+    Backend& device = opening.get()->backend;
+    if (scalar_frames > 0 && !devices)
+      std::fprintf(stderr, "start-up: device opened in %.3f s, after the last frame: all %d frames were fogged on "
+                   "the scalar path\n", opening.get()->open_s, scalar_frames);
     std::fprintf(stderr, "fogged %zu frames, %zu program build(s)\n", frames.size(),
-                 !devices || devices->backend.is_scalar() ? std::size_t(0) : devices->backend.pass()->programs().builds());
+                 device.is_scalar() ? std::size_t(0) : device.pass()->programs().builds());
     // Where the time went: the stages overlap, so the busiest one bounds the frame rate.
     const double n = double(std::max(outcome.finished, 1));
     std::fprintf(stderr, "stages per frame: read %.3f s, fog %.3f s, write %.3f s; wall %.3f s (%.2f frames/s)\n",

@@ -2,7 +2,8 @@
 // and frame N-1 is written. One thread per stage, so each stage sees the frames in order and the
 // outputs appear in order; a stage waits when the next one is a frame behind, so at most five
 // frames are alive at once (one per stage, one waiting between each two). The heavy work inside
-// the read and write stages ((de)compression) runs on OpenEXR's thread pool, shared by both.
+// the read and write stages ((de)compression) runs on OpenEXR's thread pool, shared by both. The
+// caller's thread is left for set-up that must run there (Stages::start) while frames flow.
 #pragma once
 
 #include <atomic>
@@ -28,12 +29,13 @@ class FramePipeline {
   struct Stages {
     Stage read;   // reader thread: loads the frame's inputs
     Stage fog;    // fog thread: the passes (the device); skipped for a frame that failed to read
-    Stage write;  // the caller's thread: writes the outputs; skipped for a failed frame
-    // The caller's thread, once, after the reader and fog threads have started and before the
-    // first write (may be empty): set-up that overlaps the first read. Must not throw.
+    Stage write;  // writer thread: writes the outputs; skipped for a failed frame
+    // The caller's thread, once, after the stage threads have started (may be empty): set-up
+    // that overlaps the frames' reading, fogging and writing. run() returns when it and the
+    // frames are done. Must not throw.
     std::function<void()> start;
-    // The caller's thread, in frame order, after each frame: error "" or what failed. Returns
-    // false to stop the run (frames not yet written are dropped).
+    // Writer thread, in frame order, after each frame: error "" or what failed. Returns false to
+    // stop the run (frames not yet written are dropped).
     std::function<bool(const Job&)> done;
   };
   struct Outcome {
@@ -51,18 +53,18 @@ class FramePipeline {
     Outcome outcome;
     const auto start = Clock::now();
     double read_s = 0, fog_s = 0;  // each written by its stage's thread, read after the join
-    std::thread reader, fogger;
+    std::thread reader, fogger, writer;
     // Whatever way this function leaves, the stage threads are stopped and joined first.
     struct Joiner {
       FramePipeline& p;
-      std::thread &a, &b;
+      std::thread &a, &b, &c;
       void join() {
         p.stop();
-        if (a.joinable()) a.join();
-        if (b.joinable()) b.join();
+        for (std::thread* t : {&a, &b, &c})
+          if (t->joinable()) t->join();
       }
       ~Joiner() { join(); }
-    } joiner{p, reader, fogger};
+    } joiner{p, reader, fogger, writer};
     reader = std::thread([&] {
       for (int frame : frames) {
         if (p.stopped()) break;
@@ -80,13 +82,17 @@ class FramePipeline {
       }
       p.fog_to_write_.close();
     });
+    writer = std::thread([&] {
+      while (auto job = p.fog_to_write_.pop(p)) {
+        if (p.interrupted()) break;
+        if ((*job)->error.empty()) outcome.write_s += timed(**job, stages.write);
+        ++outcome.finished;
+        if (!stages.done(**job)) break;
+      }
+      p.stop();  // done() stopped the run, or every frame is written: the other stages end too
+    });
     if (stages.start) stages.start();
-    while (auto job = p.fog_to_write_.pop(p)) {
-      if (p.interrupted()) break;
-      if ((*job)->error.empty()) outcome.write_s += timed(**job, stages.write);
-      ++outcome.finished;
-      if (!stages.done(**job)) break;
-    }
+    writer.join();
     outcome.interrupted = p.interrupted() && outcome.finished < int(frames.size());
     joiner.join();
     outcome.read_s = read_s;

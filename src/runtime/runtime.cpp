@@ -15,6 +15,12 @@ std::string lower(std::string s) {
   return s;
 }
 
+// PoCL: what the project installs and tests, and the CPU device whose kernel gives the scalar
+// path's bits (kernel_factor_bits_test.cpp).
+bool is_pocl(const cl::Platform& platform) {
+  return platform.getInfo<CL_PLATFORM_NAME>().find("Portable Computing") != std::string::npos;
+}
+
 struct Candidate {
   cl::Platform platform;
   cl::Device device;
@@ -62,6 +68,11 @@ bool device_is_cpu(cl_device_id device) {
   return with_cl_errors([&] { return (wrap(device).getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0; });
 }
 
+bool device_is_pocl_cpu(cl_device_id device) {
+  return device_is_cpu(device) &&
+         with_cl_errors([&] { return is_pocl(cl::Platform(wrap(device).getInfo<CL_DEVICE_PLATFORM>())); });
+}
+
 std::string device_opencl_c_version(cl_device_id device) {
   return with_cl_errors([&] { return wrap(device).getInfo<CL_DEVICE_OPENCL_C_VERSION>(); });
 }
@@ -87,7 +98,7 @@ cl_device_id find_device(const std::string& choice) {
         match = lower(c.label + " " + c.device.getInfo<CL_DEVICE_VENDOR>()).find(want) != std::string::npos;
       if (!match) continue;
       // For "cpu", PoCL wins over other CPU drivers: it is what the project installs and tests.
-      const bool pocl = c.platform.getInfo<CL_PLATFORM_NAME>().find("Portable Computing") != std::string::npos;
+      const bool pocl = is_pocl(c.platform);
       if (found == nullptr || (want == "cpu" && pocl)) found = &c;
       if (pocl || want != "cpu") break;
     }

@@ -26,6 +26,7 @@ cl_device_id find_device(const std::string& choice);
 // Device queries the rest of the library needs. Throw fogcl::ClError on failure.
 std::string device_opencl_c_version(cl_device_id device);  // CL_DEVICE_OPENCL_C_VERSION
 bool device_is_cpu(cl_device_id device);                   // CL_DEVICE_TYPE has CPU
+bool device_is_pocl_cpu(cl_device_id device);              // ... and PoCL's platform
 std::string device_name(cl_device_id device);              // CL_DEVICE_NAME
 
 // A compiled program per (device, source name, build options) within one context. The first
