@@ -138,7 +138,12 @@ TEST(FramePipeline, StartRunsOnceOnTheCallersThreadWhileFramesAreWritten) {
   EXPECT_EQ(writes_during_start, 6);  // every frame went through while start() ran
 }
 
-TEST(FramePipeline, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
+class FramePipelineModes : public testing::TestWithParam<bool> {};  // serial (one core) or threaded
+INSTANTIATE_TEST_SUITE_P(Serial, FramePipelineModes, testing::Bool(),
+                         [](const auto& info) { return info.param ? std::string("serial") : std::string("threads"); });
+
+TEST_P(FramePipelineModes, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
+  const bool serial = GetParam();
   FramePipeline<FakeJob>::Stages s;
   std::vector<int> fogged, written, reported;
   s.read = [](FakeJob& j) {
@@ -159,7 +164,7 @@ TEST(FramePipeline, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
     }
     return true;  // --keep-going
   };
-  auto outcome = FramePipeline<FakeJob>::run(range(1, 6), s, nullptr);
+  auto outcome = FramePipeline<FakeJob>::run(range(1, 6), s, nullptr, serial);
   EXPECT_EQ(outcome.finished, 6);
   EXPECT_EQ(reported, range(1, 6));
   EXPECT_EQ(written, (std::vector<int>{1, 2, 4, 6}));
@@ -172,9 +177,38 @@ TEST(FramePipeline, AFailedFrameSkipsItsLaterStagesAndCanStopTheRun) {
     reported.push_back(j.frame);
     return j.error.empty();
   };
-  outcome = FramePipeline<FakeJob>::run(range(1, 30), s, nullptr);
+  outcome = FramePipeline<FakeJob>::run(range(1, 30), s, nullptr, serial);
   EXPECT_EQ(written, (std::vector<int>{1, 2}));
   EXPECT_EQ(reported, (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(FakeJob::alive.load(), 0);
+}
+
+// One core: start() first, then each frame's read, fog and write in turn, all on the caller's
+// thread (nothing could overlap; interleaved stages would evict each other's caches).
+TEST(FramePipeline, SerialRunsStartThenEachFrameInTurnOnTheCallersThread) {
+  FramePipeline<FakeJob>::Stages s;
+  std::vector<std::string> order;
+  bool other_thread = false;
+  const std::thread::id caller = std::this_thread::get_id();
+  const auto here = [&](const char* what, int frame) {
+    other_thread |= std::this_thread::get_id() != caller;
+    order.push_back(std::string(what) + std::to_string(frame));
+  };
+  const auto stage = [&](const char* what) {
+    return [&, what](FakeJob& j) { here(what, j.frame); };
+  };
+  s.read = stage("r");
+  s.fog = stage("f");
+  s.write = stage("w");
+  s.start = [&] { here("start", 0); };
+  s.done = [&](const FakeJob& j) {
+    here("done", j.frame);
+    return true;
+  };
+  const auto outcome = FramePipeline<FakeJob>::run(range(1, 2), s, nullptr, true);
+  EXPECT_EQ(outcome.finished, 2);
+  EXPECT_FALSE(other_thread);
+  EXPECT_EQ(order, (std::vector<std::string>{"start0", "r1", "f1", "w1", "done1", "r2", "f2", "w2", "done2"}));
   EXPECT_EQ(FakeJob::alive.load(), 0);
 }
 
@@ -533,13 +567,43 @@ TEST_F(Sequence, TieringIsOnlyForPoclsCpuDeviceAtThePrecisePrecisionOnSeveralCor
   const struct {
     const char* extra;
     std::string env;
-  } runs[] = {{" --device portable", ""},  // PoCL's platform name: a device named by text {" --device cpu --precision fast", ""}, {" --device scalar", ""},
+  } runs[] = {{" --device portable", ""},  // PoCL's platform name: a device named by text
+              {" --device cpu --precision fast", ""},
+              {" --device scalar", ""},
               {" --device cpu", one_core}};
   for (const auto& [extra, env] : runs) {
     const CliRun r = run_cli(inputs() + extra + " --verbose --out " + path("out/o.####.exr"), env);
     ASSERT_EQ(r.exit_code, 0) << extra << ": " << r.output;
     EXPECT_EQ(r.output.find("tiering"), std::string::npos) << extra << ": " << r.output;
     EXPECT_EQ(tier_split(r.output).scalar_frames, 0) << extra << ": " << r.output;
+  }
+}
+
+// On one core the CLI runs each frame's stages in turn on one thread (FramePipeline's serial run):
+// the same files, byte for byte, as the pipelined run on every core, failures listed the same.
+TEST_F(Sequence, OneCoreRunsTheStagesInTurnWithTheSameBytes) {
+  if (allowed_cores().size() < 2 || std::system("taskset -c 0 true >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "needs taskset and two cores to compare with";
+  make_frames(4, 64, 36);
+  std::ofstream(path("in/" + frame_name("color", 3)), std::ios::trunc) << "not an EXR file";
+  const std::string one_core = "taskset -c " + std::to_string(allowed_cores().front());
+  std::vector<std::string> devices{"scalar"};
+  if (runtime() != nullptr) devices.push_back("cpu");
+  for (const std::string& device : devices) {
+    const std::string args = inputs() + " --keep-going --verbose --device " + device;
+    const CliRun serial = run_cli(args + " --out " + path("out/serial.####.exr"), one_core);
+    const CliRun threads = run_cli(args + " --out " + path("out/threads.####.exr"));
+    EXPECT_EQ(serial.exit_code, 1) << serial.output;  // frame 3 failed, the others were written
+    EXPECT_EQ(threads.exit_code, 1) << threads.output;
+    EXPECT_NE(serial.output.find("pipeline: one core available"), std::string::npos) << serial.output;
+    EXPECT_EQ(threads.output.find("pipeline: one core available"), std::string::npos) << threads.output;
+    EXPECT_NE(serial.output.find("1 of 4 frames failed"), std::string::npos) << serial.output;
+    for (int f : {1, 2, 4}) {
+      const std::vector<char> bytes = file_bytes(path("out/" + frame_name("serial", f)));
+      EXPECT_FALSE(bytes.empty()) << device << " frame " << f;
+      EXPECT_EQ(bytes, file_bytes(path("out/" + frame_name("threads", f)))) << device << " frame " << f;
+    }
+    EXPECT_FALSE(fs::exists(path("out/" + frame_name("serial", 3))));
   }
 }
 

@@ -454,13 +454,19 @@ int run_apply(const ApplyOptions& o) {
   // One device, one context, one program cache for every frame: opened by the pipeline's start
   // (this thread) while the first frames go through, taken by the fog stage when it needs it
   // (tiered: once it has opened). A device that fails to open stops the run (not a frame failure).
-  const bool tiered = tiers(o, available_cores());
+  const int cores = available_cores();
+  const bool tiered = tiers(o, cores);
+  // One core: the stages run one after another on this thread (FramePipeline::run, serial).
+  const bool serial = cores == 1;
   std::promise<std::shared_ptr<Devices>> opened;
   const std::shared_future<std::shared_ptr<Devices>> opening = opened.get_future();
   std::string device_error;  // this thread's (start() runs here)
   if (o.verbose) {
     std::fprintf(stderr, "threads: %d (OpenEXR (de)compression%s)\n", threads,
                  resolve_device_choice(o.device) == "scalar" ? "" : "; PoCL's POCL_MAX_PTHREAD_COUNT unless set");
+    if (serial)
+      std::fprintf(stderr, "pipeline: one core available: each frame is read, fogged and written in turn on one "
+                   "thread (nothing can overlap; interleaved stages would evict each other's caches)\n");
     if (tiered)
       std::fprintf(stderr, "tiering: frames that reach the fog stage while the device opens are fogged on the scalar "
                    "path (the same bits as PoCL's CPU kernel)\n");
@@ -544,8 +550,9 @@ int run_apply(const ApplyOptions& o) {
     const double passes_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (o.verbose && first_on_device) {
       if (scalar_frames == 0)
-        std::fprintf(stderr, "start-up: device opened in %.3f s (while frame %d was read); "
-                     "frame %d's passes %.3f s (program builds included)\n", devices->open_s, job.frame, job.frame, passes_s);
+        std::fprintf(stderr, "start-up: device opened in %.3f s (%s frame %d was read); "
+                     "frame %d's passes %.3f s (program builds included)\n", devices->open_s,
+                     serial ? "before" : "while", job.frame, job.frame, passes_s);
       else {
         std::fprintf(stderr, "start-up: device %s opened in %.3f s, the first frame's program built in %.3f s on the "
                      "main thread; %d frame(s) fogged on the scalar path meanwhile (%d-%d); from frame %d on the "
@@ -581,7 +588,7 @@ int run_apply(const ApplyOptions& o) {
   };
   g_interrupt = 0;
   catch_interrupts();
-  const auto outcome = FramePipeline<FrameJob>::run(frames, stages, &g_interrupt);
+  const auto outcome = FramePipeline<FrameJob>::run(frames, stages, &g_interrupt, serial);
   // A device that fails to open is one error for the run whenever it fails, also after frames
   // fogged on the scalar path meanwhile were written (tiered): those stay, complete and with the
   // bits PoCL's CPU kernel gives, and the message says which.

@@ -47,8 +47,13 @@ class FramePipeline {
   };
 
   // Runs `frames` through the stages. A non-zero *interrupt (set by a signal handler) stops it:
-  // the write in progress completes, nothing else starts.
-  static Outcome run(const std::vector<int>& frames, const Stages& stages, const std::atomic<int>* interrupt) {
+  // the write in progress completes, nothing else starts. `serial`: start(), then each frame's
+  // stages one after another on the caller's thread, for a process with one core, where nothing
+  // can overlap and interleaving the stages only makes them evict each other's caches (a 4K PIZ
+  // frame's decoder and encoder buffers are a megabyte or more each).
+  static Outcome run(const std::vector<int>& frames, const Stages& stages, const std::atomic<int>* interrupt,
+                     bool serial = false) {
+    if (serial) return run_serial(frames, stages, interrupt);
     FramePipeline p(interrupt);
     Outcome outcome;
     const auto start = Clock::now();
@@ -103,6 +108,28 @@ class FramePipeline {
 
  private:
   explicit FramePipeline(const std::atomic<int>* interrupt) : interrupt_(interrupt) {}
+
+  static Outcome run_serial(const std::vector<int>& frames, const Stages& stages, const std::atomic<int>* interrupt) {
+    FramePipeline p(interrupt);
+    Outcome outcome;
+    const auto start = Clock::now();
+    if (stages.start) stages.start();
+    for (int frame : frames) {
+      if (p.interrupted()) break;
+      Job job;
+      job.frame = frame;
+      outcome.read_s += timed(job, stages.read);
+      if (p.interrupted()) break;  // as the threads: only a write in progress completes
+      if (job.error.empty()) outcome.fog_s += timed(job, stages.fog);
+      if (p.interrupted()) break;
+      if (job.error.empty()) outcome.write_s += timed(job, stages.write);
+      ++outcome.finished;
+      if (!stages.done(job)) break;
+    }
+    outcome.interrupted = p.interrupted() && outcome.finished < int(frames.size());
+    outcome.total_s = std::chrono::duration<double>(Clock::now() - start).count();
+    return outcome;
+  }
 
   bool interrupted() const { return interrupt_ != nullptr && interrupt_->load() != 0; }
   bool stopped() const { return stop_.load() || interrupted(); }
