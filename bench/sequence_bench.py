@@ -10,6 +10,8 @@ fogcl binary of before the pipeline (one thread, float output) runs on --baselin
   bench/sequence_bench.py --bin build --out out/sequence [--threads 1,2,16] [--reps 3]
                           [--cases 1080p-float-zip,...] [--baseline OLD_FOGCL] [--device cpu|scalar]
                           [--pin]   (runs with N threads on N cores: taskset -c 0-(N-1))
+                          [--first-core K]  (with --pin: cores K..K+N-1; a VM's core 0 also
+                                             serves its interrupts)
 
 Writes OUT/runs.json (every run) and OUT/table.md (medians, frames/s and ratios).
 """
@@ -56,6 +58,7 @@ def main():
     ap.add_argument("--baseline-cases", default="1080p-float-zip")
     ap.add_argument("--device", default="cpu")
     ap.add_argument("--pin", action="store_true")
+    ap.add_argument("--first-core", type=int, default=0)
     ap.add_argument("--scratch", default=None, help="where outputs are written (default OUT/scratch)")
     a = ap.parse_args()
     fogcl, peer, make = (find(a.bin, n) for n in ("fogcl", "fogcl_exr_peer", "fogcl_make_sequence"))
@@ -84,7 +87,7 @@ def main():
         shutil.rmtree(scratch, ignore_errors=True)
         scratch.mkdir(parents=True)
         if a.pin:
-            cmd = ["taskset", "-c", f"0-{t - 1}"] + cmd
+            cmd = ["taskset", "-c", f"{a.first_core}-{a.first_core + t - 1}"] + cmd
         start = time.perf_counter()
         r = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         seconds = time.perf_counter() - start
@@ -121,7 +124,7 @@ def main():
 
 def save(out, a, runs):
     meta = {"machine": platform.node(), "cores": len(os.sched_getaffinity(0)), "device": a.device,
-            "pinned": a.pin, "reps": a.reps, "time": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
+            "pinned": a.pin, "first_core": a.first_core, "reps": a.reps, "time": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
     (out / "runs.json").write_text(json.dumps({"meta": meta, "runs": runs}, indent=1))
     (out / "table.md").write_text(table(meta, runs))
     return meta
