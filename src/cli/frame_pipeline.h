@@ -3,7 +3,8 @@
 // outputs appear in order; a stage waits when the next one is a frame behind, so at most five
 // frames are alive at once (one per stage, one waiting between each two). The heavy work inside
 // the read and write stages ((de)compression) runs on OpenEXR's thread pool, shared by both. The
-// caller's thread is left for set-up that must run there (Stages::start) while frames flow.
+// caller's thread is left for set-up that must run there (Stages::start) while frames flow. With
+// one core the stages run in turn on the caller's thread instead (run(..., serial)).
 #pragma once
 
 #include <atomic>
