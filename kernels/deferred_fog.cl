@@ -68,30 +68,17 @@
 /* What the ray term is: |ray|, or |ray|^2 for distance-based exp2 (fog_math.h, FOG_SQUARED). */
 #define FOG_USE_SQUARED FOG_SQUARED(FOG_MODE, FOG_USE_DISTANCE)
 
-#define FOG_REAL float
-#define FOG_INT int
-#define FOG_AS_UINT as_uint
-#define FOG_TRUNC_INT convert_int
-#define FOG_TO_REAL convert_float
-#define FOG_AS_REAL as_float
-#define FOG_NAME(name) name
-#include "fog_math.h" /* undefines the instance macros above */
+#include "fog_math.h" /* the one-pixel instance */
 
 #if FOG_VECTOR_WIDTH == 16
 #include "fog_cpu_avx512.h"
 #endif
-#define FOG_REAL float16
-#define FOG_INT int16
-#define FOG_AS_UINT as_uint16
-#define FOG_TRUNC_INT convert_int16
-#define FOG_TO_REAL convert_float16
-#define FOG_AS_REAL as_float16
+#define FOG_LANES16
 #ifdef FOG_AVX512
 #define FOG_CEIL fog_ceil_avx512
 #define FOG_EXP2_LDEXP fog_exp2_ldexp_avx512
 #endif
-#define FOG_NAME(name) name##_v
-#include "fog_math.h" /* undefines the instance macros above */
+#include "fog_math.h" /* the 16-pixel instance */
 
 #ifdef FOG_COLOR_HALF
 #define COLOR_T half

@@ -5,10 +5,11 @@
  *     exactly like the scalar version);
  *   - C++ (src/pass/scalar_fog.cpp): FOG_FN makes each function a template on FOG_REAL, so the
  *     same text runs in float for the baseline and in double for the reference.
- * The includer defines FOG_INT, FOG_NAME and the hooks of fog_exp2_poly (FOG_EXP2, FOG_TRUNC_INT,
- * FOG_TO_REAL, FOG_AS_REAL; optionally FOG_CEIL and FOG_EXP2_LDEXP), plus FOG_REAL and
- * FOG_AS_UINT in OpenCL C; this file has no include guard on purpose and undefines those
- * instance macros (not FOG_EXP2) at its end. Only operations that exist in both languages
+ * In OpenCL C this file defines the instance's macros itself (below): the one-pixel instance, or
+ * the 16-pixel one when the includer defines FOG_LANES16; the includer defines FOG_EXP2 and may
+ * define the optional hooks FOG_CEIL and FOG_EXP2_LDEXP. In C++ the includer defines FOG_INT,
+ * FOG_NAME, FOG_TRUNC_INT, FOG_TO_REAL and FOG_AS_REAL. This file has no include guard on purpose
+ * and undefines the instance macros (not FOG_EXP2) at its end. Only operations that exist in both languages
  * appear: + - * /, fma, expm1, sqrt, fmin, fmax, integer + and <<, a float -> int conversion, and
  * ?: (a per-lane select on vectors in OpenCL C), besides the optional hooks.
  * Sources: Unity's UnityCG.cginc (Linear01Depth, UNITY_CALC_FOG_FACTOR_RAW) and Catlike Coding,
@@ -19,6 +20,27 @@
 #define FOG_FN static inline
 #else
 #define FOG_FN template <typename FOG_REAL> inline
+#endif
+#endif
+
+/* The OpenCL C instances: lanes are independent pixels, names of the 16-pixel one end in _v. */
+#if defined(__OPENCL_C_VERSION__) && !defined(FOG_REAL)
+#ifdef FOG_LANES16
+#define FOG_REAL float16
+#define FOG_INT int16
+#define FOG_AS_UINT as_uint16
+#define FOG_TRUNC_INT convert_int16
+#define FOG_TO_REAL convert_float16
+#define FOG_AS_REAL as_float16
+#define FOG_NAME(name) name##_v
+#else
+#define FOG_REAL float
+#define FOG_INT int
+#define FOG_AS_UINT as_uint
+#define FOG_TRUNC_INT convert_int
+#define FOG_TO_REAL convert_float
+#define FOG_AS_REAL as_float
+#define FOG_NAME(name) name
 #endif
 #endif
 
@@ -287,3 +309,4 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
 #undef FOG_CEIL
 #undef FOG_EXP2_LDEXP
 #undef FOG_NAME
+#undef FOG_LANES16

@@ -20,15 +20,8 @@
 #if VOL_LANES == 16
 #define FOG_CLAMP_BY_SELECT /* as in deferred_fog.cl: LLVM keeps IEEE comparisons */
 #endif
-#define FOG_REAL float
-#define FOG_INT int
-#define FOG_AS_UINT as_uint
-#define FOG_TRUNC_INT convert_int
-#define FOG_TO_REAL convert_float
-#define FOG_AS_REAL as_float
-#define FOG_NAME(name) name
 #define FOG_EXP2 FOG_NAME(fog_exp2_poly)
-#include "fog_math.h"
+#include "fog_math.h" /* the one-pixel instance */
 
 #ifdef REVERSED_Z
 #define VOL_REVERSED_Z 1
@@ -82,13 +75,7 @@ static inline void vol_composite_pixel(global const COLOR_T* color_in, global co
 }
 
 #if VOL_LANES == 16
-#define FOG_REAL float16
-#define FOG_INT int16
-#define FOG_AS_UINT as_uint16
-#define FOG_TRUNC_INT convert_int16
-#define FOG_TO_REAL convert_float16
-#define FOG_AS_REAL as_float16
-#define FOG_NAME(name) name##_v
+#define FOG_LANES16
 #include "fog_math.h" /* the depth formulas lane-wise */
 #include "fog_cpu_avx512.h"
 #include "volume_composite_cpu.h"

@@ -25,15 +25,8 @@
  */
 #pragma OPENCL FP_CONTRACT OFF
 
-#define FOG_REAL float
-#define FOG_INT int
-#define FOG_AS_UINT as_uint
-#define FOG_TRUNC_INT convert_int
-#define FOG_TO_REAL convert_float
-#define FOG_AS_REAL as_float
-#define FOG_NAME(name) name
 #define FOG_EXP2 fog_exp2_poly
-#include "fog_math.h"
+#include "fog_math.h" /* the one-pixel instance */
 
 #ifndef VOL_LANES
 #define VOL_LANES 1
