@@ -491,7 +491,6 @@ int run_apply(const ApplyOptions& o) {
 
   Spares<ColorImage> spares;
   Spares<InputFrames> spare_inputs;
-  bool first_read = false;  // the reader's
   // Tiered: the first frame's variant (nullopt: it failed to read), for the main thread's build.
   std::promise<std::optional<Variant>> first_variant;
   FramePipeline<FrameJob>::Stages stages;
@@ -500,8 +499,7 @@ int run_apply(const ApplyOptions& o) {
     job.paths = {frame_path(color, f), o.depth_path.empty() ? "" : frame_path(depth, f), frame_path(out, f),
                  o.png_path.empty() ? "" : frame_path(png, f)};
     InputFrames spare = spare_inputs.take();
-    const bool first = !first_read;
-    first_read = true;
+    const bool first = f == frames.front();
     try {
       read_frame(o, job, &spare);
     } catch (...) {
