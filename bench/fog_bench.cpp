@@ -296,24 +296,26 @@ Runtime* runtime(benchmark::State& state) {
   return rt.get();
 }
 
-FogPass& shared_pass(Runtime& rt, bool streaming_stores = false) {
-  CpuCodegen nt;
-  nt.streaming_stores = true;
-  static FogPass streaming(rt, nt), plain(rt);
-  return streaming_stores ? streaming : plain;
+// nt: the RGBA32F store path, as BM_OpenCLDevice's range "nt": 0 ordinary stores, 1 non-temporal
+// stores, 2 by frame size (CpuCodegen's default: what users get).
+FogPass& shared_pass(Runtime& rt, int nt = 2) {
+  using S = CpuCodegen::Streaming;
+  const auto codegen = [](S s) { CpuCodegen c; c.streaming_stores = s; return c; };
+  static FogPass plain(rt, codegen(S::never)), streaming(rt, codegen(S::always)), by_size(rt);
+  return nt == 0 ? plain : nt == 1 ? streaming : by_size;
 }
 
 void BM_OpenCLDevice(benchmark::State& state) {
   Runtime* rt = runtime(state);
   if (rt == nullptr) return;
-  FogPass& pass = shared_pass(*rt, state.range(5) != 0);
+  FogPass& pass = shared_pass(*rt, int(state.range(5)));
   const cl_mem_flags host = rt->is_cpu() ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
   const Case c = case_of(state);
   const DemoFrame& frame_in = frame(c.w, c.h, c.format);
   const DeviceCopy& copy = device_copy(wrap(rt->context()), frame_in);
   double pass_s = 0, copy_s = 0;
   bool read_back = false, first = true;
-  timed_fog(state, state.range(5) ? "opencl-device-nt" : "opencl-device", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+  timed_fog(state, state.range(5) == 0 ? "opencl-device-plain" : state.range(5) == 1 ? "opencl-device-nt" : "opencl-device", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     // Buffers wrap the same host memory every time (created once per frame and output).
     // The cl::Buffers own the handles; FrameBuffers borrows them.
     struct Buffers {
@@ -426,7 +428,10 @@ void BM_HostCallParts(benchmark::State& state) {
   FogPass& pass = shared_pass(*rt);
   const Case c = case_of(state);
   const int way = int(state.range(5));
+  const bool interleave = state.range(6) != 0;
   const DemoFrame& f = frame(c.w, c.h, c.format);
+  ColorImage copy_out(f.color.width(), f.color.height(), f.color.format());
+  DepthImage copy_depth(f.depth.width(), f.depth.height());
   ColorImage out(f.color.width(), f.color.height(), f.color.format());
   pass.prepare(c.settings, f.params, c.format);
   pass.apply(f.color, f.depth, out, f.params, c.settings);  // first touch of `out`
@@ -504,6 +509,7 @@ void BM_HostCallParts(benchmark::State& state) {
     fresh.reset();
     release += seconds_since(a);
     state.SetIterationTime(seconds_since(begin) - check_seconds);
+    if (interleave) copy_bytes(f, copy_out, copy_depth, 2);  // not counted: as in timed_fog
   }
   if (mapped_in != nullptr) {
     queue.enqueueUnmapMemObject(kept->color_in, mapped_in);
@@ -715,15 +721,15 @@ void FogArgs(benchmark::internal::Benchmark* b) {
   b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
 }
 
-// As FogArgs, plus nt: streaming stores off (the default) on every case, and on for RGBA32F to
-// show what they are worth.
+// As FogArgs, plus nt (shared_pass): the default store path (2, by frame size) on every case, and
+// for RGBA32F ordinary (0) and non-temporal (1) stores forced, to show what each is worth.
 void DeviceArgs(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h", "mode", "dist", "f16", "nt"});
   for (auto [w, h] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}})
     for (int mode : {0, 1, 2})
       for (int dist : {0, 1}) {
-        for (int f16 : {0, 1}) b->Args({w, h, mode, dist, f16, 0});
-        b->Args({w, h, mode, dist, 0, 1});
+        for (int f16 : {0, 1}) b->Args({w, h, mode, dist, f16, 2});
+        for (int nt : {0, 1}) b->Args({w, h, mode, dist, 0, nt});
       }
   b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
 }
@@ -735,7 +741,7 @@ void CacheResidentArgs(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h", "mode", "dist", "f16", "nt"});
   for (int mode : {0, 1, 2})
     for (int dist : {0, 1})
-      for (int f16 : {0, 1}) b->Args({512, 256, mode, dist, f16, 0});
+      for (int f16 : {0, 1}) b->Args({512, 256, mode, dist, f16, 2});
   b->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.2);
 }
 
@@ -757,10 +763,10 @@ BENCHMARK(BM_OpenCLDevice)->Apply(DeviceArgs);
 BENCHMARK(BM_OpenCLDevice)->Name("BM_OpenCLDeviceCacheResident")->Apply(CacheResidentArgs);
 BENCHMARK(BM_OpenCLHostCall)->Apply(FogArgs);
 BENCHMARK(BM_HostCallParts)
-    ->ArgNames({"w", "h", "mode", "dist", "f16", "way"})
-    ->ArgsProduct({{64}, {64}, {2}, {0}, {0}, {0, 1, 2, 3, 4, 5, 6, 7}})
-    ->ArgsProduct({{1920}, {1080}, {0, 2}, {0}, {0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}})
-    ->ArgsProduct({{3840}, {2160}, {0, 2}, {0}, {0, 1}, {0, 4, 5, 6, 7}})
+    ->ArgNames({"w", "h", "mode", "dist", "f16", "way", "memcpy"})
+    ->ArgsProduct({{64}, {64}, {2}, {0}, {0}, {0, 1, 2, 3, 4, 5, 6, 7}, {0}})
+    ->ArgsProduct({{1920}, {1080}, {0, 2}, {0}, {0, 1}, {0, 1, 2, 3, 4, 5, 6, 7}, {0, 1}})
+    ->ArgsProduct({{3840}, {2160}, {0, 2}, {0}, {0, 1}, {0, 4, 5, 6, 7}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2);

@@ -12,7 +12,8 @@
  *   FOG_NATIVE_MATH   native_sqrt, and native_exp2 on GPUs (the `fast` precision, with
  *                     -cl-fast-relaxed-math)
  *   FOG_VECTOR_WIDTH  pixels per work-item: 16 on CPU devices, 1 elsewhere.
- *   FOG_STREAMING_STORES  non-temporal stores of RGBA32F blocks (CPU devices)
+ *   FOG_STREAMING_MIN_PIXELS  CPU devices, RGBA32F: frames of at least this many pixels are
+ *                     written with non-temporal stores (0: every frame; absent: none)
  *   FOG_PORTABLE      CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
  *
  * Why 16 pixels per work-item on CPUs: PoCL vectorises only across work-items, and a library
@@ -91,6 +92,7 @@ typedef struct {
   float zx, zy, near_plane, far_plane, k_a, k_b;
   float4 fog_color, bl, br, tl, tr;
   float inv_width, height;
+  int stream; /* FOG_STREAMING_MIN_PIXELS: this frame's blocks use non-temporal stores */
 } FogConstants;
 
 /* Blends one pixel (index i in the frame; color RGBA at 4 * i) with its fog factor f. */
@@ -155,6 +157,11 @@ kernel void deferred_fog(global const COLOR_T* color_in, global const float* dep
   k.tr = corner_tr;
   k.inv_width = 1.0f / (float)width;
   k.height = (float)height;
+#ifdef FOG_STREAMING_MIN_PIXELS
+  k.stream = (long)width * (long)height >= (long)FOG_STREAMING_MIN_PIXELS;
+#else
+  k.stream = 0;
+#endif
   const int y = get_global_id(1);
   const size_t row = (size_t)y * (size_t)width;
 #if FOG_VECTOR_WIDTH == 16

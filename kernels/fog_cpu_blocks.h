@@ -44,13 +44,15 @@ static inline float16 fog_load_quad(global const COLOR_T* p, uint q) {
 #endif
 }
 
-static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q) {
+static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q, const FogConstants* k) {
 #ifndef FOG_COLOR_HALF
-#if defined(FOG_STREAMING_STORES) && defined(__clang__)
-  /* Streaming (non-temporal) stores where the quad is 64-byte aligned: the output is never read
-   * by this pass, so skipping the read-for-ownership saves a third of the memory traffic of a
-   * write. The driver's completion signalling (locked instructions) orders them for the host. */
-  if ((((size_t)(p + 16 * q)) & 63) == 0) {
+#if defined(FOG_STREAMING_MIN_PIXELS) && defined(__clang__)
+  /* Streaming (non-temporal) stores of a frame too large for the last-level cache (k->stream),
+   * where the quad is 64-byte aligned: the output is never read by this pass, so skipping the
+   * read-for-ownership saves a third of the memory traffic of a write. The driver's completion
+   * signalling (locked instructions, which drain the write-combining buffers) orders them for
+   * the host. */
+  if (k->stream && (((size_t)(p + 16 * q)) & 63) == 0) {
     __builtin_nontemporal_store(value, (global float16*)(p + 16 * q));
     return;
   }
@@ -105,7 +107,16 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   global uint* out_bits = (global uint*)out;
   const uint keep = fog_lanes_equal(f, 1.0f);
   if (keep == 0xffffu) {
-    for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16) FOG_COPY16(in_bits + w, out_bits + w);
+    for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16) {
+#if defined(FOG_STREAMING_MIN_PIXELS) && defined(__clang__)
+      if (k->stream && (((size_t)(out_bits + w)) & 63) == 0) {  /* as fog_store_quad */
+        __builtin_nontemporal_store(__builtin_bit_cast(uint16, *(global const fog_v16u_u*)(in_bits + w)),
+                                    (global uint16*)(out_bits + w));
+        continue;
+      }
+#endif
+      FOG_COPY16(in_bits + w, out_bits + w);
+    }
     return;
   }
   const float16 fog_rgba = (float16)(k->fog_color.xyz, 0.0f, k->fog_color.xyz, 0.0f,
@@ -113,7 +124,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   const uint fogged = fog_lanes_equal(f, 0.0f);
   if (fogged == 0xffffu) {
     for (uint q = 0; q < 4; ++q)
-      fog_store_quad(select(fog_rgba, fog_load_quad(in, q), FOG_ALPHA_LANES), out, q);
+      fog_store_quad(select(fog_rgba, fog_load_quad(in, q), FOG_ALPHA_LANES), out, q, k);
     return;
   }
   if ((keep | fogged) == 0) {
@@ -121,7 +132,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   {                                                                                              \
     const float16 c = fog_load_quad(in, q);                                                      \
     fog_store_quad(select(fog_blend_mix_v(c, fog_rgba, FOG_QUAD_FACTORS(f, q)), c, FOG_ALPHA_LANES), \
-                   out, q);                                                                      \
+                   out, q, k);                                                                   \
   }
     FOG_QUAD_MIX(0)
     FOG_QUAD_MIX(1)
@@ -131,7 +142,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
     return;
   }
 #define FOG_QUAD_BLEND(q) \
-  fog_store_quad(fog_blend_v(fog_load_quad(in, q), fog_rgba, FOG_QUAD_FACTORS(f, q)), out, q);
+  fog_store_quad(fog_blend_v(fog_load_quad(in, q), fog_rgba, FOG_QUAD_FACTORS(f, q)), out, q, k);
   FOG_QUAD_BLEND(0)
   FOG_QUAD_BLEND(1)
   FOG_QUAD_BLEND(2)

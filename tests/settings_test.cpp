@@ -285,6 +285,32 @@ TEST(VariantTest, BuildOptionsExactStrings) {
   EXPECT_EQ(build_options(variant(KernelMode::exp2), gpu), "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_VECTOR_WIDTH=1");
 }
 
+// Streaming stores by frame size: from 3/4 of the device's last-level cache of RGBA32F output (a
+// 32 MiB L3: 1572864 pixels, so 1080p streams and 720p does not), never for half storage, GPUs or
+// an unknown cache size; forced on (0) or off by CpuCodegen.
+TEST(VariantTest, BuildOptionsStreamingStoresByFrameSize) {
+  DeviceTraits cpu;
+  cpu.cache_bytes = 32ull << 20;
+  EXPECT_EQ(streaming_min_pixels(cpu), 1572864);
+  EXPECT_GT(1920 * 1080, streaming_min_pixels(cpu));
+  EXPECT_LT(1280 * 720, streaming_min_pixels(cpu));
+  EXPECT_EQ(build_options(variant(KernelMode::exp2), cpu),
+            "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_VECTOR_WIDTH=16 -D FOG_STREAMING_MIN_PIXELS=1572864");
+  EXPECT_FALSE(has_define(build_options(variant(KernelMode::exp2, false, false, false, ColorFormat::rgba16f), cpu),
+                          "FOG_STREAMING_MIN_PIXELS"));
+  DeviceTraits unknown;  // cache_bytes 0
+  EXPECT_EQ(streaming_min_pixels(unknown), -1);
+  EXPECT_FALSE(has_define(build_options(variant(KernelMode::exp2), unknown), "FOG_STREAMING_MIN_PIXELS"));
+  DeviceTraits gpu = cpu;
+  gpu.cpu = false;
+  EXPECT_EQ(streaming_min_pixels(gpu), -1);
+  DeviceTraits always = cpu, never = cpu;
+  always.codegen.streaming_stores = CpuCodegen::Streaming::always;
+  never.codegen.streaming_stores = CpuCodegen::Streaming::never;
+  EXPECT_TRUE(has_token(build_options(variant(KernelMode::exp2), always), "FOG_STREAMING_MIN_PIXELS=0"));
+  EXPECT_FALSE(has_define(build_options(variant(KernelMode::exp2), never), "FOG_STREAMING_MIN_PIXELS"));
+}
+
 TEST(VariantTest, BuildOptionsModeNumbers) {
   const std::pair<KernelMode, const char*> modes[] = {{KernelMode::linear, "FOG_MODE=1"},
                                                       {KernelMode::linear_step, "FOG_MODE=2"},

@@ -77,6 +77,10 @@ std::string device_opencl_c_version(cl_device_id device) {
   return with_cl_errors([&] { return wrap(device).getInfo<CL_DEVICE_OPENCL_C_VERSION>(); });
 }
 
+unsigned long long device_cache_bytes(cl_device_id device) {
+  return with_cl_errors([&] { return (unsigned long long)wrap(device).getInfo<CL_DEVICE_GLOBAL_MEM_CACHE_SIZE>(); });
+}
+
 std::string device_name(cl_device_id device) {
   return with_cl_errors([&] { return wrap(device).getInfo<CL_DEVICE_NAME>(); });
 }

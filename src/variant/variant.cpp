@@ -35,6 +35,19 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
 
 int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }
 
+long long streaming_min_pixels(const DeviceTraits& device) {
+  if (!device.cpu) return -1;  // GPUs: one pixel per work-item, their own store paths
+  switch (device.codegen.streaming_stores) {
+    case CpuCodegen::Streaming::always: return 0;
+    case CpuCodegen::Streaming::never: return -1;
+    case CpuCodegen::Streaming::by_frame_size: break;
+  }
+  if (device.cache_bytes == 0) return -1;
+  // glibc's memcpy turns to non-temporal stores from 3/4 of the shared cache for the same reason:
+  // an output that large evicts itself (and the inputs) before anyone reads it back.
+  return (long long)(device.cache_bytes * 3 / 4 / 16);  // 16 bytes per RGBA32F pixel
+}
+
 std::string cl_std_option(const DeviceTraits& device) {
   const std::string& version = device.opencl_c_version;
   int major = 0, minor = 0;
@@ -57,8 +70,9 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
-  if (device.cpu && device.codegen.streaming_stores && v.storage == ColorFormat::rgba32f)
-    o += " -D FOG_STREAMING_STORES";
+  const long long stream_from = streaming_min_pixels(device);
+  if (stream_from >= 0 && v.storage == ColorFormat::rgba32f)
+    o += " -D FOG_STREAMING_MIN_PIXELS=" + std::to_string(stream_from);
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }

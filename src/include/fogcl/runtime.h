@@ -28,6 +28,7 @@ std::string device_opencl_c_version(cl_device_id device);  // CL_DEVICE_OPENCL_C
 bool device_is_cpu(cl_device_id device);                   // CL_DEVICE_TYPE has CPU
 bool device_is_pocl_cpu(cl_device_id device);              // ... and PoCL's platform
 std::string device_name(cl_device_id device);              // CL_DEVICE_NAME
+unsigned long long device_cache_bytes(cl_device_id device);  // CL_DEVICE_GLOBAL_MEM_CACHE_SIZE
 
 // A compiled program per (device, source name, build options) within one context. The first
 // request builds (PoCL additionally keeps its own on-disk cache across processes); later ones

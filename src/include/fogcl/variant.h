@@ -42,10 +42,15 @@ Variant select_variant(const FogSettings& settings, const CameraParams& camera, 
 // Code generation choices of the CPU kernel path, for benchmarks and tests; the defaults are
 // what fogcl uses.
 struct CpuCodegen {
-  // Write RGBA32F output with non-temporal stores (no read-for-ownership of the output). Off:
-  // measured slower on PoCL 3.1 / 2-core EPYC (1.50 vs 1.00 ms at 1080p, linear fog), where a
-  // 1080p frame partly stays in the large L3. bench/ keeps measuring it.
-  bool streaming_stores = false;
+  // Non-temporal stores of RGBA32F output (no read-for-ownership of the output lines: a third
+  // less memory traffic for a write). by_frame_size (the default): for frames whose output is at
+  // least 3/4 of the device's last-level cache (CL_DEVICE_GLOBAL_MEM_CACHE_SIZE; from 1080p on a
+  // 32 MiB L3), which cannot stay in that cache anyway; smaller frames keep ordinary stores, so a
+  // following pass finds them in cache. The kernel reads the frame size, so one program serves
+  // every size. On the 2-core EPYC (PoCL 3.1, 2 threads) streaming took 0.89-0.92x the time at
+  // 1080p and 0.74-0.89x at 4K (README, "Streaming stores"). always / never: for the benchmark's A/B.
+  enum class Streaming { by_frame_size, always, never };
+  Streaming streaming_stores = Streaming::by_frame_size;
   // Use the target's SIMD builtins where the kernel has them (x86 AVX-512: lane masks, 16-wide
   // half conversions). false builds the portable OpenCL C path that other CPUs run, so that
   // tests on an AVX-512 machine cover it too.
@@ -56,8 +61,13 @@ struct CpuCodegen {
 struct DeviceTraits {
   std::string opencl_c_version = "OpenCL C 1.2";  // CL_DEVICE_OPENCL_C_VERSION
   bool cpu = true;                                // CL_DEVICE_TYPE_CPU
+  unsigned long long cache_bytes = 0;             // CL_DEVICE_GLOBAL_MEM_CACHE_SIZE (0: unknown)
   CpuCodegen codegen;                             // read on CPU devices only
 };
+
+// The smallest frame [pixels] whose RGBA32F output a CPU kernel writes with non-temporal stores
+// (CpuCodegen::streaming_stores); 0 = every frame; -1 = none.
+long long streaming_min_pixels(const DeviceTraits& device);
 
 // Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
 int pixels_per_work_item(const DeviceTraits& device);
