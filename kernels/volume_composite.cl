@@ -10,6 +10,8 @@
  *                    vectorises only across work-items, and this kernel's per-pixel branches
  *                    keep it from doing so), 1 elsewhere (coalesced GPU accesses)
  *   FOG_PORTABLE     CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
+ *   FOG_STREAMING_MIN_PIXELS  CPU devices, RGBA32F: frames of at least this many pixels are
+ *                    written with non-temporal stores (0: every frame; absent: none)
  * Global size: (ceil(width / VOL_LANES), height).
  */
 #pragma OPENCL FP_CONTRACT OFF
@@ -89,8 +91,13 @@ kernel void volume_composite(global const COLOR_T* color_in, global const float*
   const size_t row = (size_t)y * (size_t)width;
 #if VOL_LANES == 16
   const int x0 = get_global_id(0) * 16;
+#ifdef FOG_STREAMING_MIN_PIXELS
+  const int stream = (long)width * (long)frame[VOL_F_HEIGHT] >= (long)FOG_STREAMING_MIN_PIXELS;
+#else
+  const int stream = 0;
+#endif
   if (x0 + 16 <= width) {
-    vol_composite16(color_in, depth, color_out, frame, low, low_key, row + x0, x0, y);
+    vol_composite16(color_in, depth, color_out, frame, low, low_key, row + x0, x0, y, stream);
   } else {
     for (int x = x0; x < width; ++x) vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, row + x, x, y);
   }

@@ -98,7 +98,8 @@ static inline float16 vol_window_keys(global const float* low_key, size_t at, in
 
 /* Quad q of the block as bits: the composite where 0 < A, the input's bits where A == 0 and in
  * the alpha lanes (vol_composite's rules; A == 1 writes P exactly). */
-static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* out, uint q, float16 fog) {
+static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* out, uint q, float16 fog,
+                                      int stream) {
   const float16 a = VOL_QUAD_ALPHA(fog);
   const int16 keep = (a == 0.0f) | VOL_ALPHA_LANES;
 #ifdef FOG_COLOR_HALF
@@ -123,19 +124,28 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
   const uint16 bits = vload16(q, (global const uint*)in);
   const float16 c = as_float16(bits);
   const float16 o = select(fog + c * (1.0f - a), fog, a == 1.0f);
-  VOL_STORE16U(select(as_uint16(o), bits, keep), (global uint*)out + 16 * q);
+  const uint16 result = select(as_uint16(o), bits, keep);
+#if defined(FOG_STREAMING_MIN_PIXELS) && defined(__clang__)
+  /* A frame too large for the last-level cache (fog_cpu_blocks.h's fog_store_quad): non-temporal
+   * stores where the quad is 64-byte aligned. */
+  if (stream && (((size_t)((global uint*)out + 16 * q)) & 63) == 0) {
+    __builtin_nontemporal_store(result, (global uint16*)((global uint*)out + 16 * q));
+    return;
+  }
+#endif
+  VOL_STORE16U(result, (global uint*)out + 16 * q);
 #endif
 }
 
 /* 16 pixels of row y from column x0 (a multiple of 16, x0 + 16 <= width), frame index i0. */
 static inline void vol_composite16(global const COLOR_T* color_in, global const float* depth,
                                    global COLOR_T* color_out, global const float* frame, global const float* low,
-                                   global const float* low_key, size_t i0, int x0, int y) {
+                                   global const float* low_key, size_t i0, int x0, int y, int stream) {
   global const COLOR_T* in = color_in + 4 * i0;
   global COLOR_T* out = color_out + 4 * i0;
 #if VOL_SCALE == 1
   /* The target is the frame's own resolution: each pixel's own sample, unchanged. */
-  for (uint q = 0; q < 4; ++q) vol_composite_quad(in, out, q, vload16(q, low + 4 * i0));
+  for (uint q = 0; q < 4; ++q) vol_composite_quad(in, out, q, vload16(q, low + 4 * i0), stream);
 #else
   const int low_width = (int)frame[VOL_F_LOW_WIDTH];
   int y0, y1;
@@ -179,7 +189,7 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
                         shuffle(t, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w1, q) +                            \
                         shuffle(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q) +                             \
                         shuffle(u, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w3, q);                             \
-    vol_composite_quad(in, out, q, VOL_NORMALISE(sum, q));                                               \
+    vol_composite_quad(in, out, q, VOL_NORMALISE(sum, q), stream);                                       \
   }
   VOL_QUAD(0)
   VOL_QUAD(1)
