@@ -43,9 +43,10 @@ long long streaming_min_pixels(const DeviceTraits& device) {
     case CpuCodegen::Streaming::by_frame_size: break;
   }
   if (device.cache_bytes == 0) return -1;
-  // glibc's memcpy turns to non-temporal stores from 3/4 of the shared cache for the same reason:
-  // an output that large evicts itself (and the inputs) before anyone reads it back.
-  return (long long)(device.cache_bytes * 3 / 4 / 16);  // 16 bytes per RGBA32F pixel
+  // From frames whose pass traffic (RGBA32F in and out, depth: 36 bytes a pixel) is half the
+  // last-level cache: the output then evicts itself, and the inputs, before anyone reads it back,
+  // and its read-for-ownership is a third of the pass's traffic spent for nothing.
+  return (long long)(device.cache_bytes / 2 / 36);
 }
 
 std::string cl_std_option(const DeviceTraits& device) {
