@@ -3,7 +3,19 @@
  * bytes (CpuCodegen::target_intrinsics = false defines FOG_PORTABLE; tests/cpu_block_paths_test
  * and tests/kernel_factor_bits_test compare the two). Included by deferred_fog.cl before the
  * float16 instance of fog_math.h, whose exp2 hooks are defined here; fog_cpu_blocks.h uses the
- * rest. */
+ * rest. Also FOG_SHUFFLE, the constant-mask shuffle of the CPU paths (any target). */
+
+/* shuffle2(a, b, (uint16)(indices)) with literal indices, as one permute. clang's
+ * __builtin_shufflevector is a language builtin (no target needed): PoCL 5.0 (Ubuntu 24.04)
+ * lowers OpenCL's shuffle / shuffle2 to a call of an out-of-line library routine that reads the
+ * mask at run time, four of them per 16-pixel block, which made the deferred kernel 5-7x slower
+ * on the 16-core Xeon (README, "The shuffle call of PoCL 5"); PoCL 3.1 inlined them. */
+#ifdef __clang__
+#define FOG_SHUFFLE(a, b, ...) __builtin_shufflevector((a), (b), __VA_ARGS__)
+#else
+#define FOG_SHUFFLE(a, b, ...) shuffle2((a), (b), (uint16)(__VA_ARGS__))
+#endif
+
 #if defined(__clang__) && defined(__AVX512F__) && !defined(FOG_PORTABLE)
 #define FOG_AVX512 1
 typedef float fog_v16f __attribute__((__vector_size__(64)));

@@ -66,13 +66,11 @@ static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q, cons
 #endif
 }
 
-/* Pixel j's factor in its R, G, B lanes and 1 in its alpha lane (q: pixels 4q..4q+3), which
- * makes fog_blend pass alpha through. Shuffle masks must be literal constants to become one
- * permute instruction. */
-#define FOG_QUAD_FACTORS(f, q)                                                                \
-  shuffle2(f, (float16)1.0f,                                                                  \
-           (uint16)(4 * q, 4 * q, 4 * q, 16, 4 * q + 1, 4 * q + 1, 4 * q + 1, 16, 4 * q + 2, \
-                    4 * q + 2, 4 * q + 2, 16, 4 * q + 3, 4 * q + 3, 4 * q + 3, 16))
+/* Pixel j's factor in its R, G, B lanes and 1 in its alpha lane (q: pixels 4q..4q+3, a literal),
+ * which makes fog_blend pass alpha through. */
+#define FOG_QUAD_FACTORS(f, q)                                                                     \
+  FOG_SHUFFLE(f, (float16)1.0f, 4 * q, 4 * q, 4 * q, 16, 4 * q + 1, 4 * q + 1, 4 * q + 1, 16, 4 * q + 2, \
+              4 * q + 2, 4 * q + 2, 16, 4 * q + 3, 4 * q + 3, 4 * q + 3, 16)
 #define FOG_ALPHA_LANES (int16)(0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1)
 
 /* 16 pixels of one row starting at frame index i0, column x0. Each block takes the cheapest

@@ -29,24 +29,25 @@ typedef ushort vol_v16h_u __attribute__((__vector_size__(32), aligned(2)));
 #endif
 
 #define VOL_LANE_INDEX (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
-/* Shuffle masks must be literal constants to become one permute instruction. L_j, and within a
- * quad's 4-column window the column of each pixel's left tap (its right tap is the next one). */
+/* Shuffle masks (literal constants: one permute each, FOG_SHUFFLE). L_j, and within a quad's
+ * 4-column window the column of each pixel's left tap (its right tap is the next one). */
 #if VOL_SCALE == 2
-#define VOL_LEFT_TAP (uint16)(0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8)
-#define VOL_RIGHT_TAP (uint16)(1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9)
-#define VOL_QUAD_LEFT (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11)
-#define VOL_QUAD_RIGHT (uint16)(4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11, 12, 13, 14, 15)
+#define VOL_LEFT_TAP 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8
+#define VOL_RIGHT_TAP 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9
+#define VOL_QUAD_LEFT 0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11
+#define VOL_QUAD_RIGHT 4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11, 12, 13, 14, 15
 #elif VOL_SCALE == 4
-#define VOL_LEFT_TAP (uint16)(0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4)
-#define VOL_RIGHT_TAP (uint16)(1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5)
-#define VOL_QUAD_LEFT (uint16)(0, 1, 2, 3, 0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7)
-#define VOL_QUAD_RIGHT (uint16)(4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11)
+#define VOL_LEFT_TAP 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4
+#define VOL_RIGHT_TAP 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5
+#define VOL_QUAD_LEFT 0, 1, 2, 3, 0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7
+#define VOL_QUAD_RIGHT 4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11
 #endif
-/* Lanes 4q .. 4q + 3 of a per-pixel float16, each spread over its pixel's RGBA lanes. */
-#define VOL_QUAD_SPREAD(v, q)                                                                         \
-  shuffle((v), (uint16)(4 * q, 4 * q, 4 * q, 4 * q, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 2, \
-                        4 * q + 2, 4 * q + 2, 4 * q + 2, 4 * q + 3, 4 * q + 3, 4 * q + 3, 4 * q + 3))
-#define VOL_QUAD_ALPHA(v) shuffle((v), (uint16)(3, 3, 3, 3, 7, 7, 7, 7, 11, 11, 11, 11, 15, 15, 15, 15))
+#define VOL_SHUFFLE(v, ...) FOG_SHUFFLE((v), (v), __VA_ARGS__)
+/* Lanes 4q .. 4q + 3 of a per-pixel float16 (q a literal), each spread over its pixel's RGBA lanes. */
+#define VOL_QUAD_SPREAD(v, q)                                                                       \
+  VOL_SHUFFLE((v), 4 * q, 4 * q, 4 * q, 4 * q, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 2, \
+              4 * q + 2, 4 * q + 2, 4 * q + 2, 4 * q + 3, 4 * q + 3, 4 * q + 3, 4 * q + 3)
+#define VOL_QUAD_ALPHA(v) VOL_SHUFFLE((v), 3, 3, 3, 3, 7, 7, 7, 7, 11, 11, 11, 11, 15, 15, 15, 15)
 #define VOL_ALPHA_LANES (int16)(0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1)
 
 /* vol_eye_depth (volume_ray.h) lane-wise: the same operations, selects for its branches. */
@@ -166,7 +167,7 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   const float16 r_key = vol_key_reciprocal_v(key), r_top = vol_key_reciprocal_v(top_keys),
                 r_bottom = vol_key_reciprocal_v(bottom_keys);
 #define VOL_E(keys, r, tap) \
-  (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, shuffle(keys, tap), r_key, shuffle(r, tap)))
+  (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, VOL_SHUFFLE(keys, tap), r_key, VOL_SHUFFLE(r, tap)))
   const float16 e0 = VOL_E(top_keys, r_top, VOL_LEFT_TAP), e1 = VOL_E(top_keys, r_top, VOL_RIGHT_TAP),
                 e2 = VOL_E(bottom_keys, r_bottom, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, r_bottom, VOL_RIGHT_TAP);
 #undef VOL_E
@@ -185,10 +186,10 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
     const int c = b + 4 * q / VOL_SCALE;                                                                 \
     const float16 t = vol_window_rgba(low, top, c, low_width, inside);                                   \
     const float16 u = vol_window_rgba(low, bottom, c, low_width, inside);                                \
-    const float16 sum = 0.0f + shuffle(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q) +                      \
-                        shuffle(t, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w1, q) +                            \
-                        shuffle(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q) +                             \
-                        shuffle(u, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w3, q);                             \
+    const float16 sum = 0.0f + VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q) +                  \
+                        VOL_SHUFFLE(t, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w1, q) +                        \
+                        VOL_SHUFFLE(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q) +                         \
+                        VOL_SHUFFLE(u, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w3, q);                         \
     vol_composite_quad(in, out, q, VOL_NORMALISE(sum, q), stream);                                       \
   }
   VOL_QUAD(0)
