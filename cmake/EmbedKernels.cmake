@@ -23,3 +23,15 @@ function(fogcl_embed_kernel)
   target_sources(${ARG_TARGET} PRIVATE ${out})
   target_include_directories(${ARG_TARGET} PRIVATE ${out_dir})
 endfunction()
+
+# White-box tests and benchmarks that build a kernel themselves include the library's own
+# generated headers: the symbols are inline variables, so a second embedding of the same kernel
+# with fewer dependencies would be a second definition that the linker may pick, stale (the
+# bench's deferred_fog_cl once missed an edit of fog_cpu_blocks.h and replaced the library's).
+#   fogcl_use_embedded_kernels(TARGET <tgt> FROM <library target that embeds them>)
+function(fogcl_use_embedded_kernels)
+  cmake_parse_arguments(ARG "" "TARGET;FROM" "" ${ARGN})
+  get_target_property(from_dir ${ARG_FROM} BINARY_DIR)
+  target_include_directories(${ARG_TARGET} PRIVATE ${from_dir}/generated/fogcl_kernels)
+  add_dependencies(${ARG_TARGET} ${ARG_FROM})
+endfunction()
