@@ -286,19 +286,20 @@ TEST(VariantTest, BuildOptionsExactStrings) {
 }
 
 // Streaming stores by frame size: from pass traffic (36 bytes a pixel) of half the device's
-// last-level cache (a 32 MiB L3: 466033 pixels, so 720p streams and the 512x256 cache-resident
-// frame does not; a 300 MiB one: 4K streams, 1080p not), never for half storage, GPUs or an
-// unknown cache size; forced on (0) or off by CpuCodegen.
+// last-level cache, counted up to 32 MiB (466033 pixels: 720p streams and the 512x256
+// cache-resident frame does not, also where the cache reported is 300 MiB; 8 MiB: 116508), never
+// for half storage, GPUs or an unknown cache size; forced on (0) or off by CpuCodegen.
 TEST(VariantTest, BuildOptionsStreamingStoresByFrameSize) {
   DeviceTraits cpu;
   cpu.cache_bytes = 32ull << 20;
   EXPECT_EQ(streaming_min_pixels(cpu), 466033);
   EXPECT_GT(1280 * 720, streaming_min_pixels(cpu));
   EXPECT_LT(512 * 256, streaming_min_pixels(cpu));
-  DeviceTraits large = cpu;
+  DeviceTraits large = cpu, small = cpu;
   large.cache_bytes = 300ull << 20;
-  EXPECT_GT(3840 * 2160, streaming_min_pixels(large));
-  EXPECT_LT(1920 * 1080, streaming_min_pixels(large));
+  EXPECT_EQ(streaming_min_pixels(large), 466033);
+  small.cache_bytes = 8ull << 20;
+  EXPECT_EQ(streaming_min_pixels(small), 116508);
   EXPECT_EQ(build_options(variant(KernelMode::exp2), cpu),
             "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_VECTOR_WIDTH=16 -D FOG_STREAMING_MIN_PIXELS=466033");
   EXPECT_FALSE(has_define(build_options(variant(KernelMode::exp2, false, false, false, ColorFormat::rgba16f), cpu),
