@@ -47,11 +47,11 @@ struct CpuCodegen {
   // (color in and out, depth) is at least half the device's last-level cache
   // (CL_DEVICE_GLOBAL_MEM_CACHE_SIZE, counted up to 32 MiB; from 1280x720 up on a 32 MiB L3),
   // which cannot stay in that cache anyway; smaller frames keep ordinary stores, so a following
-  // pass finds them in cache.
-  // The kernel reads the frame size, so one program serves every size. On the 2-core EPYC (PoCL
-  // 3.1, 2 threads) streaming took 0.78-0.92x the time at 720p, 0.69-0.81x at 1080p and
-  // 0.73-0.77x at 4K; on the 16-core Xeon VM (PoCL 5.0) 0.66x at 1080p (README, "Streaming
-  // stores"). always / never: for the benchmark's A/B.
+  // pass finds them in cache. The kernel reads the frame size, so one program serves every size.
+  // On the 2-core EPYC (PoCL 3.1, 2 threads) streaming took 0.78-0.92x the time at 720p,
+  // 0.69-0.81x at 1080p and 0.73-0.77x at 4K; on the 16-core Xeon VM (PoCL 5.0) 0.66x at 1080p
+  // (README, "Streaming stores, and PoCL 5's shuffle call"). always / never: for the benchmark's
+  // A/B and the tests.
   enum class Streaming { by_frame_size, always, never };
   Streaming streaming_stores = Streaming::by_frame_size;
   // Use the target's SIMD builtins where the kernel has them (x86 AVX-512: lane masks, 16-wide
