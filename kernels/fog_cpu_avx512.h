@@ -8,7 +8,7 @@
 /* shuffle2(a, b, (uint16)(indices)) with literal indices, as one permute. clang's
  * __builtin_shufflevector is a language builtin (no target needed): PoCL 5.0 (Ubuntu 24.04)
  * lowers OpenCL's shuffle / shuffle2 to a call of an out-of-line library routine that reads the
- * mask at run time, four of them per 16-pixel block, which made the deferred kernel 5-10x slower
+ * mask at run time, four of them per 16-pixel block, which made the deferred kernel 5-12x slower
  * on the 16-core Xeon (README, "Streaming stores, and PoCL 5's shuffle call"); PoCL 3.1
  * inlined them. */
 #ifdef __clang__
