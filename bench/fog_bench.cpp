@@ -413,6 +413,8 @@ void BM_OpenCLHostCall(benchmark::State& state) {
 //   7  new buffers, the kernel, a non-blocking map and the unmap enqueued behind it, then one
 //      clFinish: the map's guarantee (USE_HOST_PTR: host_ptr holds the latest bits once the map
 //      completes) with a single wait
+// Range "memcpy" 1: a 2-thread memcpy of the frame's bytes after each iteration (not timed), as
+// BM_OpenCLHostCall's timed_fog does, so that the parts are measured under the same conditions.
 // Counters [us per call]: create_us (buffers made or found), check_us (the integration API's checks:
 // queue and buffer getInfo), sync_us (way 2's writes enqueued), enqueue_us (FogPass::enqueue: checks,
 // 13 setArg, clEnqueueNDRangeKernel; the kernel often starts and runs before it returns), wait_us

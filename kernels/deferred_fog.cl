@@ -92,7 +92,7 @@ typedef struct {
   float zx, zy, near_plane, far_plane, k_a, k_b;
   float4 fog_color, bl, br, tl, tr;
   float inv_width, height;
-  int stream; /* FOG_STREAMING_MIN_PIXELS: this frame's blocks use non-temporal stores */
+  int stream; /* CPU path: this frame's blocks use non-temporal stores (FOG_STREAMS) */
 } FogConstants;
 
 /* Blends one pixel (index i in the frame; color RGBA at 4 * i) with its fog factor f. */
@@ -157,10 +157,8 @@ kernel void deferred_fog(global const COLOR_T* color_in, global const float* dep
   k.tr = corner_tr;
   k.inv_width = 1.0f / (float)width;
   k.height = (float)height;
-#ifdef FOG_STREAMING_MIN_PIXELS
-  k.stream = (long)width * (long)height >= (long)FOG_STREAMING_MIN_PIXELS;
-#else
-  k.stream = 0;
+#if FOG_VECTOR_WIDTH == 16
+  k.stream = FOG_STREAMS(width, height);
 #endif
   const int y = get_global_id(1);
   const size_t row = (size_t)y * (size_t)width;

@@ -46,17 +46,7 @@ static inline float16 fog_load_quad(global const COLOR_T* p, uint q) {
 
 static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q, const FogConstants* k) {
 #ifndef FOG_COLOR_HALF
-#if defined(FOG_STREAMING_MIN_PIXELS) && defined(__clang__)
-  /* Streaming (non-temporal) stores of a frame too large for the last-level cache (k->stream),
-   * where the quad is 64-byte aligned: the output is never read by this pass, so skipping the
-   * read-for-ownership saves a third of the memory traffic of a write. The driver's completion
-   * signalling (locked instructions, which drain the write-combining buffers) orders them for
-   * the host. */
-  if (k->stream && (((size_t)(p + 16 * q)) & 63) == 0) {
-    __builtin_nontemporal_store(value, (global float16*)(p + 16 * q));
-    return;
-  }
-#endif
+  if (fog_stream16(as_uint16(value), (global uint*)(p + 16 * q), k->stream)) return;
   FOG_STORE16(value, p + 16 * q);
 #elif defined(FOG_AVX512)
   ((global fog_v16h*)p)[q] = __builtin_ia32_vcvtps2ph512_mask(
@@ -105,16 +95,10 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   global uint* out_bits = (global uint*)out;
   const uint keep = fog_lanes_equal(f, 1.0f);
   if (keep == 0xffffu) {
-    for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16) {
-#if defined(FOG_STREAMING_MIN_PIXELS) && defined(__clang__)
-      if (k->stream && (((size_t)(out_bits + w)) & 63) == 0) {  /* as fog_store_quad */
-        __builtin_nontemporal_store(__builtin_bit_cast(uint16, *(global const fog_v16u_u*)(in_bits + w)),
-                                    (global uint16*)(out_bits + w));
-        continue;
-      }
-#endif
-      FOG_COPY16(in_bits + w, out_bits + w);
-    }
+    for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16)
+      if (!fog_stream16(__builtin_bit_cast(uint16, *(global const fog_v16u_u*)(in_bits + w)), out_bits + w,
+                        k->stream))
+        FOG_COPY16(in_bits + w, out_bits + w);
     return;
   }
   const float16 fog_rgba = (float16)(k->fog_color.xyz, 0.0f, k->fog_color.xyz, 0.0f,

@@ -91,11 +91,7 @@ kernel void volume_composite(global const COLOR_T* color_in, global const float*
   const size_t row = (size_t)y * (size_t)width;
 #if VOL_LANES == 16
   const int x0 = get_global_id(0) * 16;
-#ifdef FOG_STREAMING_MIN_PIXELS
-  const int stream = (long)width * (long)frame[VOL_F_HEIGHT] >= (long)FOG_STREAMING_MIN_PIXELS;
-#else
-  const int stream = 0;
-#endif
+  const int stream = FOG_STREAMS(width, (int)frame[VOL_F_HEIGHT]);
   if (x0 + 16 <= width) {
     vol_composite16(color_in, depth, color_out, frame, low, low_key, row + x0, x0, y, stream);
   } else {

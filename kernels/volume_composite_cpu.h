@@ -126,14 +126,7 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
   const float16 c = as_float16(bits);
   const float16 o = select(fog + c * (1.0f - a), fog, a == 1.0f);
   const uint16 result = select(as_uint16(o), bits, keep);
-#if defined(FOG_STREAMING_MIN_PIXELS) && defined(__clang__)
-  /* A frame too large for the last-level cache (fog_cpu_blocks.h's fog_store_quad): non-temporal
-   * stores where the quad is 64-byte aligned. */
-  if (stream && (((size_t)((global uint*)out + 16 * q)) & 63) == 0) {
-    __builtin_nontemporal_store(result, (global uint16*)((global uint*)out + 16 * q));
-    return;
-  }
-#endif
+  if (fog_stream16(result, (global uint*)out + 16 * q, stream)) return;
   VOL_STORE16U(result, (global uint*)out + 16 * q);
 #endif
 }

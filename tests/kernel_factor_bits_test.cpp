@@ -192,8 +192,8 @@ TEST_P(KernelOutputBits, EqualTheScalarPathBitForBit) {
   plain.target_intrinsics = false;
   FogPass portable_pass(*runtime(), plain);
   portable_pass.apply(t.color, t.depth, portable, params, s);
-  // Non-temporal stores on this small frame (by default they start at frames the size of the
-  // last-level cache): the same bits, also in the blocks that a 517-pixel row leaves unaligned.
+  // Non-temporal stores on this small frame (by default they start at frames whose pass traffic is
+  // half the last-level cache): the same bits, also in the blocks that a 517-pixel row leaves unaligned.
   CpuCodegen nt;
   nt.streaming_stores = CpuCodegen::Streaming::always;
   FogPass streaming_pass(*runtime(), nt);

@@ -154,8 +154,8 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   traits.opencl_c_version = device_opencl_c_version(runtime()->device());
   traits.cpu = c.path != Path::one_pixel;
   traits.codegen.target_intrinsics = c.path == Path::lanes;
-  // The lanes path with non-temporal RGBA32F stores (by default they start at frames the size of
-  // the last-level cache), the portable one with ordinary stores: 83-pixel rows give both aligned
+  // The lanes path with non-temporal RGBA32F stores (by default they start at frames whose pass
+  // traffic is half the last-level cache), the portable one with ordinary stores: 83-pixel rows give both aligned
   // and unaligned quads.
   traits.codegen.streaming_stores = c.path == Path::lanes ? CpuCodegen::Streaming::always : CpuCodegen::Streaming::never;
   const std::string options = detail::volume_composite_options(variant, traits);

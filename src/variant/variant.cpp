@@ -54,6 +54,12 @@ long long streaming_min_pixels(const DeviceTraits& device) {
   return (long long)(cache / 2 / 36);
 }
 
+std::string streaming_store_option(const DeviceTraits& device, ColorFormat storage) {
+  const long long from = streaming_min_pixels(device);
+  if (from < 0 || storage != ColorFormat::rgba32f) return "";  // half output: ordinary stores
+  return " -D FOG_STREAMING_MIN_PIXELS=" + std::to_string(from);
+}
+
 std::string cl_std_option(const DeviceTraits& device) {
   const std::string& version = device.opencl_c_version;
   int major = 0, minor = 0;
@@ -76,9 +82,7 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
-  const long long stream_from = streaming_min_pixels(device);
-  if (stream_from >= 0 && v.storage == ColorFormat::rgba32f)
-    o += " -D FOG_STREAMING_MIN_PIXELS=" + std::to_string(stream_from);
+  o += streaming_store_option(device, v.storage);
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }

@@ -358,10 +358,7 @@ std::string volume_composite_options(const VolumeVariant& v, const DeviceTraits&
   if (v.reversed_z) o += " -D REVERSED_Z";
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   o += " -D VOL_LANES=" + std::to_string(pixels_per_work_item(device));
-  // As the deferred pass's (variant.h, CpuCodegen::streaming_stores): frames too large for the
-  // last-level cache are written with non-temporal stores.
-  if (const long long from = streaming_min_pixels(device); from >= 0 && v.storage == ColorFormat::rgba32f)
-    o += " -D FOG_STREAMING_MIN_PIXELS=" + std::to_string(from);
+  o += streaming_store_option(device, v.storage);  // as the deferred pass's (variant.h)
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }

@@ -71,6 +71,9 @@ struct DeviceTraits {
 // The smallest frame [pixels] whose RGBA32F output a CPU kernel writes with non-temporal stores
 // (CpuCodegen::streaming_stores); 0 = every frame; -1 = none.
 long long streaming_min_pixels(const DeviceTraits& device);
+// " -D FOG_STREAMING_MIN_PIXELS=N" for a kernel writing `storage` on `device`, or "": the option
+// both passes' CPU kernels take (kernels/fog_cpu_avx512.h, FOG_STREAMS).
+std::string streaming_store_option(const DeviceTraits& device, ColorFormat storage);
 
 // Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
 int pixels_per_work_item(const DeviceTraits& device);
