@@ -4,7 +4,7 @@
  * and tests/kernel_factor_bits_test compare the two). Included by deferred_fog.cl before the
  * float16 instance of fog_math.h, whose exp2 hooks are defined here; fog_cpu_blocks.h uses the
  * rest. Also what both CPU paths (deferred_fog.cl, volume_composite.cl) share on any target:
- * FOG_SHUFFLE, the constant-mask shuffle, and the streaming stores (FOG_STREAMS, fog_stream16). */
+ * FOG_SHUFFLE, the constant-mask shuffle, and the streaming stores (FOG_STREAMS, FOG_STREAM_OR). */
 
 /* shuffle2(a, b, (uint16)(indices)) with literal indices, as one permute. clang's
  * __builtin_shufflevector is a language builtin (no target needed): PoCL 5.0 (Ubuntu 24.04)
@@ -19,24 +19,32 @@
 #endif
 
 /* Streaming stores (FOG_STREAMING_MIN_PIXELS, docs/DESIGN.md §3). FOG_STREAMS(width, height):
- * whether a frame's RGBA32F output is written with non-temporal stores. fog_stream16 writes 16
- * words that way where p is 64-byte aligned and returns 1, else returns 0 and the caller stores as
- * usual: no read-for-ownership of lines this pass never reads back. The driver's completion
- * signalling (locked instructions, which drain the write-combining buffers) orders them for the
- * host. Without the option (or clang) fog_stream16 is 0 and its arguments are not compiled. */
+ * whether a frame's RGBA32F output is written with non-temporal stores. FOG_STREAM_OR(bits, p,
+ * stream, ordinary): the 16 words `bits` (uint16) go to p (global uint*) with a non-temporal store
+ * where stream is set and p is 64-byte aligned, else the statement `ordinary` stores them: no
+ * read-for-ownership of lines this pass never reads back. The driver's completion signalling
+ * (locked instructions, which drain the write-combining buffers) orders them for the host. A
+ * macro, not a function: with the store behind a helper's return value, PoCL 3.1's LLVM 15 kept
+ * 3 of a kernel's 27 non-temporal stores (merged with the ordinary ones) and the composite's none. */
 #ifdef FOG_STREAMING_MIN_PIXELS
 #define FOG_STREAMS(width, height) ((long)(width) * (long)(height) >= (long)FOG_STREAMING_MIN_PIXELS)
 #else
 #define FOG_STREAMS(width, height) 0
 #endif
 #if defined(FOG_STREAMING_MIN_PIXELS) && defined(__clang__)
-static inline int fog_stream16(uint16 bits, global uint* p, int stream) {
-  if (!stream || (((size_t)p) & 63) != 0) return 0;
-  __builtin_nontemporal_store(bits, (global uint16*)p);
-  return 1;
-}
+#define FOG_STREAM_OR(bits, p, stream, ordinary)                 \
+  do {                                                           \
+    if ((stream) && (((size_t)(p)) & 63) == 0)                   \
+      __builtin_nontemporal_store((bits), (global uint16*)(p));  \
+    else {                                                       \
+      ordinary;                                                  \
+    }                                                            \
+  } while (0)
 #else
-#define fog_stream16(bits, p, stream) 0
+#define FOG_STREAM_OR(bits, p, stream, ordinary) \
+  do {                                           \
+    ordinary;                                    \
+  } while (0)
 #endif
 
 #if defined(__clang__) && defined(__AVX512F__) && !defined(FOG_PORTABLE)

@@ -46,8 +46,7 @@ static inline float16 fog_load_quad(global const COLOR_T* p, uint q) {
 
 static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q, const FogConstants* k) {
 #ifndef FOG_COLOR_HALF
-  if (fog_stream16(as_uint16(value), (global uint*)(p + 16 * q), k->stream)) return;
-  FOG_STORE16(value, p + 16 * q);
+  FOG_STREAM_OR(as_uint16(value), (global uint*)(p + 16 * q), k->stream, FOG_STORE16(value, p + 16 * q));
 #elif defined(FOG_AVX512)
   ((global fog_v16h*)p)[q] = __builtin_ia32_vcvtps2ph512_mask(
       __builtin_bit_cast(fog_v16f, value), 0 /* round to nearest even */, (fog_v16h){}, (ushort)0xffff);
@@ -96,9 +95,8 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   const uint keep = fog_lanes_equal(f, 1.0f);
   if (keep == 0xffffu) {
     for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16)
-      if (!fog_stream16(__builtin_bit_cast(uint16, *(global const fog_v16u_u*)(in_bits + w)), out_bits + w,
-                        k->stream))
-        FOG_COPY16(in_bits + w, out_bits + w);
+      FOG_STREAM_OR(__builtin_bit_cast(uint16, *(global const fog_v16u_u*)(in_bits + w)), out_bits + w, k->stream,
+                    FOG_COPY16(in_bits + w, out_bits + w));
     return;
   }
   const float16 fog_rgba = (float16)(k->fog_color.xyz, 0.0f, k->fog_color.xyz, 0.0f,

@@ -126,8 +126,7 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
   const float16 c = as_float16(bits);
   const float16 o = select(fog + c * (1.0f - a), fog, a == 1.0f);
   const uint16 result = select(as_uint16(o), bits, keep);
-  if (fog_stream16(result, (global uint*)out + 16 * q, stream)) return;
-  VOL_STORE16U(result, (global uint*)out + 16 * q);
+  FOG_STREAM_OR(result, (global uint*)out + 16 * q, stream, VOL_STORE16U(result, (global uint*)out + 16 * q));
 #endif
 }
 
