@@ -124,8 +124,11 @@ FOG_FN FOG_REAL FOG_NAME(fog_sanitize_depth)(FOG_REAL raw, int reversed_z) {
  * costing up to far/near ulps) and breaks outright once far/near >= 2^24, where float x = 1 - y
  * has lost its 1 and x + y = 0. Reversed Z (y = 1, x = far/near - 1 > 0) adds two positive
  * terms already. */
+FOG_FN FOG_REAL FOG_NAME(fog_linear01_denominator)(FOG_REAL raw, FOG_REAL zx, FOG_REAL zy, int reversed_z) {
+  return reversed_z ? fma(zx, raw, zy) : fma(zy, (FOG_REAL)1 - raw, raw);
+}
 FOG_FN FOG_REAL FOG_NAME(fog_linear01_depth)(FOG_REAL raw, FOG_REAL zx, FOG_REAL zy, int reversed_z) {
-  return (FOG_REAL)1 / (reversed_z ? fma(zx, raw, zy) : fma(zy, (FOG_REAL)1 - raw, raw));
+  return (FOG_REAL)1 / FOG_NAME(fog_linear01_denominator)(raw, zx, zy, reversed_z);
 }
 
 /* Orthographic depth is linear: Linear01Depth = x * raw + y (lerp(near, far, raw) / far). */

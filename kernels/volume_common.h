@@ -94,6 +94,8 @@
 #define VOL_F_SHADOW_WIDTH 57
 #define VOL_F_SHADOW_HEIGHT 58
 #define VOL_F_SHADOW_BIAS 59
+#define VOL_F_INV_NEAR 60    /* 1 / near, 1 / far (0 with an infinite far plane), rounded once */
+#define VOL_F_INV_FAR 61
 #define VOL_F_COUNT 64
 
 /* One volume's parameters (docs/volumetric.md §A volume), resolved defaults included. */

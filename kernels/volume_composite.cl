@@ -45,12 +45,11 @@
 static inline void vol_composite_pixel(global const COLOR_T* color_in, global const float* depth,
                                        global COLOR_T* color_out, global const float* frame, global const float* low,
                                        global const float* low_key, size_t i, int x, int y) {
-  float key = 0.0f;
+  float rho = 0.0f;
 #if VOL_DEPTH_AWARE && VOL_SCALE > 1
-  key = vol_eye_depth(depth[i], FOG_PROJECTION, VOL_REVERSED_Z, frame[VOL_F_ZX], frame[VOL_F_ZY],
-                      frame[VOL_F_NEAR], frame[VOL_F_FAR]);
+  rho = vol_inverse_eye_depth(depth[i], frame, FOG_PROJECTION, VOL_REVERSED_Z);
 #endif
-  const float4 fog = vol_upsample(x, y, key, low, low_key, (int)frame[VOL_F_LOW_WIDTH],
+  const float4 fog = vol_upsample(x, y, rho, low, low_key, (int)frame[VOL_F_LOW_WIDTH],
                                   (int)frame[VOL_F_LOW_HEIGHT], VOL_SCALE, VOL_DEPTH_AWARE);
 #ifdef FOG_COLOR_HALF
   if (fog.w == 0.0f) { /* no fog: the bits pass through (a half trip would quiet a signalling NaN) */

@@ -2,19 +2,56 @@
  * (docs/volumetric.md §Resolution, upsampling, composite). Needs volume_common.h. */
 
 /* Weight floor of the depth-aware upsampling: a tap's weight is its bilinear weight over
- * (VOL_UPSAMPLE_EPS + relative depth difference), so taps on the pixel's own surface win about
- * 50 : 1 over taps across a silhouette, and taps on one surface keep plain bilinear weights. */
+ * (VOL_UPSAMPLE_EPS + depth difference), so taps on the pixel's own surface win about 50 : 1 over
+ * taps across a silhouette, and taps on one surface keep plain bilinear weights. */
 #define VOL_UPSAMPLE_EPS 0.01f
 
-/* |a - b| / max(a, b) for eye depths >= 0 (+inf for sky): 0 for equal depths, sky included, 1
- * between sky and a surface. Written (a - b) * (1 / max(a, b)), at most 1: the CPU lanes take the
- * reciprocal once per depth, not once per pair (min(1/a, 1/b) rounds as 1/max(a, b) does), so
- * the composite does 4 divisions per 16 pixels instead of 12. */
-VOL_FN VOL_REAL vol_depth_difference(VOL_REAL a, VOL_REAL b) {
-  const VOL_REAL hi = fmax(a, b), lo = fmin(a, b);
-  if (hi == lo) return (VOL_REAL)0;
-  if (!(hi < (VOL_REAL)INFINITY)) return (VOL_REAL)1;
-  return fmin((hi - lo) * ((VOL_REAL)1 / hi), (VOL_REAL)1);
+/* The depth difference of a frame pixel (eye depth e) and a tap (the target's key k, the eye depth
+ * it marched to) is |k - e| / e capped at 1, evaluated as |1 - k rho| with rho = 1 / e from
+ * vol_inverse_eye_depth: one fma per tap, no division (docs/volumetric.md, §Resolution,
+ * upsampling, composite). Sky is k = VOL_KEY_SKY (the march's +inf, capped) and rho = VOL_RHO_SKY,
+ * whose product is exactly 1: sky against sky differs by 0, sky against a surface (eye depths
+ * below 2^100) by 1, with no inf * 0. */
+#define VOL_KEY_SKY 0x1p126f
+#define VOL_RHO_SKY 0x1p-126f
+/* Linear01Depth = 1 / q is sky (fog_is_sky: > 0.9999f, rounded as float) exactly when q is below
+ * this float (tests/volume_composite_test.cpp checks it and its neighbour). */
+#define VOL_SKY_DENOMINATOR 0x1.00068ep+0f
+
+/* 1 / eye depth of a frame pixel, from its raw depth: linear in the depth buffer for perspective
+ * cameras (q / far, q the denominator of Linear01Depth; raw / near with an infinite far plane), so
+ * the composite needs no division for it. VOL_RHO_SKY for sky, and never below it. */
+VOL_FN VOL_REAL vol_inverse_eye_depth(VOL_REAL raw, VOL_GLOBAL const float* frame, int projection, int reversed_z) {
+  const VOL_REAL zx = VOL_P(frame, VOL_F_ZX), zy = VOL_P(frame, VOL_F_ZY);
+  const VOL_REAL depth = fog_sanitize_depth(raw, reversed_z);
+  VOL_REAL rho;
+  int sky;
+  if (projection == FOG_PROJECTION_INFINITE_FAR) {
+    sky = depth == (VOL_REAL)0;
+    rho = depth * VOL_P(frame, VOL_F_INV_NEAR);
+  } else if (projection == FOG_PROJECTION_ORTHOGRAPHIC) {
+    const VOL_REAL linear01 = fog_linear01_depth_ortho(depth, zx, zy);
+    sky = fog_is_sky(linear01);
+    rho = (VOL_REAL)1 / (linear01 * VOL_P(frame, VOL_F_FAR));
+  } else {
+    const VOL_REAL q = fog_linear01_denominator(depth, zx, zy, reversed_z);
+    sky = q < (VOL_REAL)VOL_SKY_DENOMINATOR;
+    rho = q * VOL_P(frame, VOL_F_INV_FAR);
+  }
+  return sky ? (VOL_REAL)VOL_RHO_SKY : (rho > (VOL_REAL)VOL_RHO_SKY ? rho : (VOL_REAL)VOL_RHO_SKY);
+}
+
+/* The depth difference above, in [0, 1], for rho from vol_inverse_eye_depth and a target key k
+ * (an eye depth > 0, or +inf; NaN counts as sky). */
+VOL_FN VOL_REAL vol_depth_difference(VOL_REAL rho, VOL_REAL k) {
+  const VOL_REAL key = k < (VOL_REAL)VOL_KEY_SKY ? k : (VOL_REAL)VOL_KEY_SKY;
+  const VOL_REAL d = fabs(fma(-key, rho, (VOL_REAL)1));
+  return d < (VOL_REAL)1 ? d : (VOL_REAL)1;
+}
+
+/* a * w + c by component, each rounded once (GLM's fma is a * b + c). */
+VOL_FN VOL_V4 vol_fma4(VOL_V4 a, VOL_REAL w, VOL_V4 c) {
+  return VOL_MAKE4(fma(a.x, w, c.x), fma(a.y, w, c.y), fma(a.z, w, c.z), fma(a.w, w, c.w));
 }
 
 /* Along one axis: the two target pixels around full-resolution coordinate x (their centres are
@@ -28,10 +65,10 @@ VOL_FN VOL_REAL vol_upsample_axis(int x, int scale, int low_size, int* i0, int* 
   return g - f0;
 }
 
-/* The target (P, A) at full-resolution pixel (x, y) of eye depth `key`: the 2 x 2 nearest target
- * pixels, bilinear, or bilinear x depth similarity when depth_aware. Scale 1 returns the pixel's
- * own sample unchanged. */
-VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL key, VOL_GLOBAL const VOL_REAL* low, VOL_GLOBAL const VOL_REAL* low_key,
+/* The target (P, A) at full-resolution pixel (x, y) of inverse eye depth rho
+ * (vol_inverse_eye_depth): the 2 x 2 nearest target pixels, bilinear, or bilinear x depth
+ * similarity when depth_aware. Scale 1 returns the pixel's own sample unchanged. */
+VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL* low, VOL_GLOBAL const VOL_REAL* low_key,
                            int low_width, int low_height, int scale, int depth_aware) {
   if (scale == 1) {
     const size_t i = (size_t)y * (size_t)low_width + (size_t)x;
@@ -41,35 +78,37 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL key, VOL_GLOBAL const VOL_REAL
   const VOL_REAL fx = VOL_T(vol_upsample_axis)(x, scale, low_width, &x0, &x1);
   const VOL_REAL fy = VOL_T(vol_upsample_axis)(y, scale, low_height, &y0, &y1);
   const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-  const VOL_REAL bilinear[4] = {((VOL_REAL)1 - fx) * ((VOL_REAL)1 - fy), fx * ((VOL_REAL)1 - fy),
-                                ((VOL_REAL)1 - fx) * fy, fx * fy};
+  VOL_REAL w[4] = {((VOL_REAL)1 - fx) * ((VOL_REAL)1 - fy), fx * ((VOL_REAL)1 - fy), ((VOL_REAL)1 - fx) * fy,
+                   fx * fy};
   /* Depth-aware weights are bilinear[k] / e[k], e[k] = EPS + depth difference in [0.01, 1.01],
-   * here scaled by e0 e1 e2 e3 (the result is normalised): products that cannot overflow or
-   * underflow instead of 4 divisions. Bilinear weights sum to exactly 1 at s = 2 and 4. */
-  VOL_REAL w[4] = {bilinear[0], bilinear[1], bilinear[2], bilinear[3]};
+   * here scaled by e0 e1 e2 e3 (the sum is normalised): products that cannot overflow or
+   * underflow instead of 4 divisions, and one reciprocal of their sum. Bilinear weights sum to
+   * exactly 1 at s = 2 and 4. */
   if (depth_aware) {
     VOL_REAL e[4];
     for (int k = 0; k < 4; ++k)
       e[k] = (VOL_REAL)VOL_UPSAMPLE_EPS +
-             VOL_T(vol_depth_difference)(key, (VOL_REAL)low_key[(size_t)ys[k] * (size_t)low_width + (size_t)xs[k]]);
+             VOL_T(vol_depth_difference)(rho, (VOL_REAL)low_key[(size_t)ys[k] * (size_t)low_width + (size_t)xs[k]]);
     const VOL_REAL e01 = e[0] * e[1], e23 = e[2] * e[3];
-    w[0] = bilinear[0] * (e[1] * e23);
-    w[1] = bilinear[1] * (e[0] * e23);
-    w[2] = bilinear[2] * (e[3] * e01);
-    w[3] = bilinear[3] * (e[2] * e01);
+    w[0] = w[0] * (e[1] * e23);
+    w[1] = w[1] * (e[0] * e23);
+    w[2] = w[2] * (e[3] * e01);
+    w[3] = w[3] * (e[2] * e01);
+    const VOL_REAL norm = (VOL_REAL)1 / ((VOL_REAL)0 + w[0] + w[1] + w[2] + w[3]);
+    for (int k = 0; k < 4; ++k) w[k] = w[k] * norm;
   }
   VOL_V4 sum = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
-  VOL_REAL weight = 0;
   for (int k = 0; k < 4; ++k) {
     const size_t i = (size_t)ys[k] * (size_t)low_width + (size_t)xs[k];
-    sum = sum + VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3)) * w[k];
-    weight += w[k];
+    const VOL_V4 tap = VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3));
+    sum = k == 0 ? tap * w[0] : VOL_T(vol_fma4)(tap, w[k], sum);
   }
-  return depth_aware ? sum * ((VOL_REAL)1 / weight) : sum;
+  return sum;
 }
 
-/* One channel over the fog (docs/volumetric.md §Resolution, upsampling, composite): P + c (1 - A). A == 1 writes P exactly (a hidden
- * NaN/Inf never leaks); the caller passes A == 0 pixels through bit for bit. */
+/* One channel over the fog (docs/volumetric.md §Resolution, upsampling, composite): P + c (1 - A),
+ * one rounding. A == 1 writes P exactly (a hidden NaN/Inf never leaks); the caller passes A == 0
+ * pixels through bit for bit. */
 VOL_FN VOL_REAL vol_composite(VOL_REAL c, VOL_REAL premultiplied, VOL_REAL coverage) {
-  return coverage == (VOL_REAL)1 ? premultiplied : premultiplied + c * ((VOL_REAL)1 - coverage);
+  return coverage == (VOL_REAL)1 ? premultiplied : fma(c, (VOL_REAL)1 - coverage, premultiplied);
 }

@@ -50,32 +50,30 @@ typedef ushort vol_v16h_u __attribute__((__vector_size__(32), aligned(2)));
 #define VOL_QUAD_ALPHA(v) VOL_SHUFFLE((v), 3, 3, 3, 3, 7, 7, 7, 7, 11, 11, 11, 11, 15, 15, 15, 15)
 #define VOL_ALPHA_LANES (int16)(0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1)
 
-/* vol_eye_depth (volume_ray.h) lane-wise: the same operations, selects for its branches. */
-static inline float16 vol_eye_depth_v(float16 raw, float zx, float zy, float near_plane, float far_plane) {
+/* vol_inverse_eye_depth (volume_composite.h) lane-wise: the same operations, selects for its branches. */
+static inline float16 vol_inverse_eye_depth_v(float16 raw, global const float* frame) {
   const float16 depth = fog_sanitize_depth_v(raw, VOL_REVERSED_Z);
 #if FOG_PROJECTION == FOG_PROJECTION_INFINITE_FAR
-  return select(fog_eye_depth_infinite_v(depth, (float16)near_plane), (float16)INFINITY, depth == 0.0f);
+  const int16 sky = depth == 0.0f;
+  const float16 rho = depth * frame[VOL_F_INV_NEAR];
+#elif FOG_PROJECTION == FOG_PROJECTION_ORTHOGRAPHIC
+  const float16 linear01 = fog_linear01_depth_ortho_v(depth, (float16)frame[VOL_F_ZX], (float16)frame[VOL_F_ZY]);
+  const int16 sky = fog_is_sky_v(linear01);
+  const float16 rho = 1.0f / (linear01 * frame[VOL_F_FAR]);
 #else
-#if FOG_PROJECTION == FOG_PROJECTION_ORTHOGRAPHIC
-  const float16 linear01 = fog_linear01_depth_ortho_v(depth, (float16)zx, (float16)zy);
-#else
-  const float16 linear01 = fog_linear01_depth_v(depth, (float16)zx, (float16)zy, VOL_REVERSED_Z);
+  const float16 q =
+      fog_linear01_denominator_v(depth, (float16)frame[VOL_F_ZX], (float16)frame[VOL_F_ZY], VOL_REVERSED_Z);
+  const int16 sky = q < VOL_SKY_DENOMINATOR;
+  const float16 rho = q * frame[VOL_F_INV_FAR];
 #endif
-  return select(linear01 * far_plane, (float16)INFINITY, fog_is_sky_v(linear01));
-#endif
+  return select(select((float16)VOL_RHO_SKY, rho, rho > VOL_RHO_SKY), (float16)VOL_RHO_SKY, sky);
 }
 
-/* 1 / k for the keys of volume_composite.h's vol_depth_difference: fmax(k, 0) + 0 makes -0, NaN
- * and negative keys +0 (reciprocal +inf), which the fmin below then never picks over a key > 0. */
-static inline float16 vol_key_reciprocal_v(float16 k) { return 1.0f / (fmax(k, 0.0f) + 0.0f); }
-
-/* vol_depth_difference (volume_composite.h) lane-wise, given ra = 1 / a and rb = 1 / b from
- * vol_key_reciprocal_v: fmin(ra, rb) is 1 / max(a, b) rounded, as that function computes it. The
- * same operations otherwise, selects for its branches (equal depths 0, sky against a surface 1). */
-static inline float16 vol_depth_difference_v(float16 a, float16 b, float16 ra, float16 rb) {
-  const float16 hi = fmax(a, b), lo = fmin(a, b);
-  const float16 d = select(fmin((hi - lo) * fmin(ra, rb), 1.0f), (float16)1.0f, !(hi < INFINITY));
-  return select(d, (float16)0.0f, hi == lo);
+/* vol_depth_difference (volume_composite.h) lane-wise, its key already capped (vol_capped_keys_v). */
+static inline float16 vol_capped_keys_v(float16 k) { return select((float16)VOL_KEY_SKY, k, k < VOL_KEY_SKY); }
+static inline float16 vol_depth_difference_v(float16 rho, float16 key) {
+  const float16 d = fabs(fma(-key, rho, (float16)1.0f));
+  return select((float16)1.0f, d, d < 1.0f);
 }
 
 /* A target row's window for a block, as values (no private arrays: PoCL gives those a copy per
@@ -83,19 +81,37 @@ static inline float16 vol_depth_difference_v(float16 a, float16 b, float16 ra, f
  * columns b .. b + 15. Blocks whose window reaches past the row (the frame's first and last
  * blocks) gather it column by column with the edge clamp. */
 #define VOL_COLUMN(c) vload4(0, low + 4 * (at + (size_t)clamp((c), 0, low_width - 1)))
-static inline float16 vol_window_rgba(global const float* low, size_t at, int c, int low_width, int inside) {
+static inline __attribute__((always_inline)) float16 vol_window_rgba(global const float* low, size_t at, int c, int low_width, int inside) {
   if (inside) return vload16(0, low + 4 * (at + (size_t)c));
   return (float16)(VOL_COLUMN(c), VOL_COLUMN(c + 1), VOL_COLUMN(c + 2), VOL_COLUMN(c + 3));
 }
 #undef VOL_COLUMN
 #define VOL_KEY(c) low_key[at + (size_t)clamp(b + (c), 0, low_width - 1)]
-static inline float16 vol_window_keys(global const float* low_key, size_t at, int b, int low_width, int inside) {
+static inline __attribute__((always_inline)) float16 vol_window_keys(global const float* low_key, size_t at, int b, int low_width, int inside) {
   if (inside) return vload16(0, low_key + at + (size_t)b);
   return (float16)(VOL_KEY(0), VOL_KEY(1), VOL_KEY(2), VOL_KEY(3), VOL_KEY(4), VOL_KEY(5), VOL_KEY(6), VOL_KEY(7),
                    VOL_KEY(8), VOL_KEY(9), VOL_KEY(10), VOL_KEY(11), VOL_KEY(12), VOL_KEY(13), VOL_KEY(14),
                    VOL_KEY(15));
 }
 #undef VOL_KEY
+
+/* Quad q of the block unchanged: the pass-through of a quad with no fog, as bits. */
+static inline void vol_copy_quad(global const COLOR_T* in, global COLOR_T* out, uint q, int stream) {
+#ifdef FOG_COLOR_HALF
+  VOL_STORE16H(vload16(q, (global const ushort*)in), (global ushort*)out + 16 * q);
+#else
+  const uint16 bits = vload16(q, (global const uint*)in);
+  FOG_STREAM_OR(bits, (global uint*)out + 16 * q, stream, VOL_STORE16U(bits, (global uint*)out + 16 * q));
+#endif
+}
+
+/* Whether none of the (P, A) quads of a block's window has fog: every coverage is +0, so every
+ * pixel's upsampled coverage is 0 (its weights are positive and finite) and the composite passes
+ * the input through. -0 and NaN coverages take the full path, which gives them the same bits. */
+static inline int vol_fogless(float16 t0, float16 t1, float16 t2, float16 t3) {
+  const uint16 bits = (as_uint16(t0) | as_uint16(t1) | as_uint16(t2) | as_uint16(t3)) & as_uint16(VOL_ALPHA_LANES);
+  return FOG_REDUCE_OR16(bits) == 0u;
+}
 
 /* Quad q of the block as bits: the composite where 0 < A, the input's bits where A == 0 and in
  * the alpha lanes (vol_composite's rules; A == 1 writes P exactly). */
@@ -111,7 +127,7 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
 #else
   const float16 c = vload_half16(q, in);
 #endif
-  const float16 o = select(fog + c * (1.0f - a), fog, a == 1.0f);
+  const float16 o = select(fma(c, 1.0f - a, fog), fog, a == 1.0f);
 #ifdef FOG_AVX512
   const ushort16 rounded = __builtin_bit_cast(ushort16, __builtin_ia32_vcvtps2ph512_mask(
       __builtin_bit_cast(fog_v16f, o), 0 /* round to nearest even */, (fog_v16h){}, (ushort)0xffff));
@@ -124,7 +140,7 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
 #else
   const uint16 bits = vload16(q, (global const uint*)in);
   const float16 c = as_float16(bits);
-  const float16 o = select(fog + c * (1.0f - a), fog, a == 1.0f);
+  const float16 o = select(fma(c, 1.0f - a, fog), fog, a == 1.0f);
   const uint16 result = select(as_uint16(o), bits, keep);
   FOG_STREAM_OR(result, (global uint*)out + 16 * q, stream, VOL_STORE16U(result, (global uint*)out + 16 * q));
 #endif
@@ -138,7 +154,16 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   global COLOR_T* out = color_out + 4 * i0;
 #if VOL_SCALE == 1
   /* The target is the frame's own resolution: each pixel's own sample, unchanged. */
-  for (uint q = 0; q < 4; ++q) vol_composite_quad(in, out, q, vload16(q, low + 4 * i0), stream);
+  const float16 f0 = vload16(0, low + 4 * i0), f1 = vload16(1, low + 4 * i0), f2 = vload16(2, low + 4 * i0),
+                f3 = vload16(3, low + 4 * i0);
+  if (vol_fogless(f0, f1, f2, f3)) {
+    for (uint q = 0; q < 4; ++q) vol_copy_quad(in, out, q, stream);
+    return;
+  }
+  vol_composite_quad(in, out, 0, f0, stream);
+  vol_composite_quad(in, out, 1, f1, stream);
+  vol_composite_quad(in, out, 2, f2, stream);
+  vol_composite_quad(in, out, 3, f3, stream);
 #else
   const int low_width = (int)frame[VOL_F_LOW_WIDTH];
   int y0, y1;
@@ -148,20 +173,27 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   const int b = x0 / VOL_SCALE - 1;
   const int inside = b >= 0 && b + 15 < low_width; /* the keys' load reaches b + 15 */
   const size_t top = (size_t)y0 * (size_t)low_width, bottom = (size_t)y1 * (size_t)low_width;
+  /* The target's windows of the 4 quads (quad q from column b + 4q / s), in the top and bottom rows. */
+#define VOL_WINDOW(row, q) vol_window_rgba(low, (row), b + 4 * (q) / VOL_SCALE, low_width, inside)
+  const float16 t0 = VOL_WINDOW(top, 0), t1 = VOL_WINDOW(top, 1), t2 = VOL_WINDOW(top, 2), t3 = VOL_WINDOW(top, 3);
+  const float16 u0 = VOL_WINDOW(bottom, 0), u1 = VOL_WINDOW(bottom, 1), u2 = VOL_WINDOW(bottom, 2),
+                u3 = VOL_WINDOW(bottom, 3);
+#undef VOL_WINDOW
+  /* Blocks away from the volumes (most of a frame, usually) are a copy: no depth, no weights. */
+  if (vol_fogless(t0, t1, t2, t3) && vol_fogless(u0, u1, u2, u3)) {
+    for (uint q = 0; q < 4; ++q) vol_copy_quad(in, out, q, stream);
+    return;
+  }
   float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
 #if VOL_DEPTH_AWARE
-  /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), then one
+  /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), normalised by one
    * reciprocal of their sum per pixel. */
-  const float16 key = vol_eye_depth_v(vload16(0, depth + i0), frame[VOL_F_ZX], frame[VOL_F_ZY],
-                                      frame[VOL_F_NEAR], frame[VOL_F_FAR]);
-  const float16 top_keys = vol_window_keys(low_key, top, b, low_width, inside);
-  const float16 bottom_keys = vol_window_keys(low_key, bottom, b, low_width, inside);
-  const float16 r_key = vol_key_reciprocal_v(key), r_top = vol_key_reciprocal_v(top_keys),
-                r_bottom = vol_key_reciprocal_v(bottom_keys);
-#define VOL_E(keys, r, tap) \
-  (VOL_UPSAMPLE_EPS + vol_depth_difference_v(key, VOL_SHUFFLE(keys, tap), r_key, VOL_SHUFFLE(r, tap)))
-  const float16 e0 = VOL_E(top_keys, r_top, VOL_LEFT_TAP), e1 = VOL_E(top_keys, r_top, VOL_RIGHT_TAP),
-                e2 = VOL_E(bottom_keys, r_bottom, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, r_bottom, VOL_RIGHT_TAP);
+  const float16 rho = vol_inverse_eye_depth_v(vload16(0, depth + i0), frame);
+  const float16 top_keys = vol_capped_keys_v(vol_window_keys(low_key, top, b, low_width, inside));
+  const float16 bottom_keys = vol_capped_keys_v(vol_window_keys(low_key, bottom, b, low_width, inside));
+#define VOL_E(keys, tap) (VOL_UPSAMPLE_EPS + vol_depth_difference_v(rho, VOL_SHUFFLE(keys, tap)))
+  const float16 e0 = VOL_E(top_keys, VOL_LEFT_TAP), e1 = VOL_E(top_keys, VOL_RIGHT_TAP),
+                e2 = VOL_E(bottom_keys, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, VOL_RIGHT_TAP);
 #undef VOL_E
   const float16 e01 = e0 * e1, e23 = e2 * e3;
   w0 = w0 * (e1 * e23);
@@ -169,27 +201,25 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   w2 = w2 * (e3 * e01);
   w3 = w3 * (e2 * e01);
   const float16 norm = 1.0f / (0.0f + w0 + w1 + w2 + w3);
-#define VOL_NORMALISE(sum, q) ((sum) * VOL_QUAD_SPREAD(norm, q))
-#else
-#define VOL_NORMALISE(sum, q) (sum) /* the bilinear weights sum to exactly 1 */
+  w0 = w0 * norm;
+  w1 = w1 * norm;
+  w2 = w2 * norm;
+  w3 = w3 * norm;
 #endif
-#define VOL_QUAD(q)                                                                                      \
-  {                                                                                                      \
-    const int c = b + 4 * q / VOL_SCALE;                                                                 \
-    const float16 t = vol_window_rgba(low, top, c, low_width, inside);                                   \
-    const float16 u = vol_window_rgba(low, bottom, c, low_width, inside);                                \
-    const float16 sum = 0.0f + VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q) +                  \
-                        VOL_SHUFFLE(t, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w1, q) +                        \
-                        VOL_SHUFFLE(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q) +                         \
-                        VOL_SHUFFLE(u, VOL_QUAD_RIGHT) * VOL_QUAD_SPREAD(w3, q);                         \
-    vol_composite_quad(in, out, q, VOL_NORMALISE(sum, q), stream);                                       \
+  /* The taps in vol_upsample's order: top left, top right, bottom left, bottom right. */
+#define VOL_QUAD(q, t, u)                                                                    \
+  {                                                                                          \
+    float16 sum = VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q);                    \
+    sum = fma(VOL_SHUFFLE(t, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w1, q), sum);                  \
+    sum = fma(VOL_SHUFFLE(u, VOL_QUAD_LEFT), VOL_QUAD_SPREAD(w2, q), sum);                   \
+    sum = fma(VOL_SHUFFLE(u, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w3, q), sum);                  \
+    vol_composite_quad(in, out, q, sum, stream);                                             \
   }
-  VOL_QUAD(0)
-  VOL_QUAD(1)
-  VOL_QUAD(2)
-  VOL_QUAD(3)
+  VOL_QUAD(0, t0, u0)
+  VOL_QUAD(1, t1, u1)
+  VOL_QUAD(2, t2, u2)
+  VOL_QUAD(3, t3, u3)
 #undef VOL_QUAD
-#undef VOL_NORMALISE
 #endif
 }
 

@@ -1,5 +1,5 @@
 // The upsample + composite kernel (kernels/volume_composite.cl) on its own, against the C++ formulas
-// it compiles from (volume_formulas: vol_eye_depth, vol_upsample, vol_composite), bit for bit on
+// it compiles from (volume_formulas: vol_inverse_eye_depth, vol_upsample, vol_composite), bit for bit on
 // CPU devices: the 16-pixel path (with AVX-512 builtins and portable), its row tails, and the
 // one-pixel path GPUs run. Synthetic targets give every case its share: A == 0 (the color's bits
 // pass through, signalling NaNs included), A == 1 (P exactly, NaN/Inf colors hidden), partial A
@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <array>
+#include <algorithm>
 #include <limits>
 #include <random>
 #include <vector>
@@ -113,7 +115,7 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
         }
       }
     }
-  // Target: a band of A == 0 (whole blocks clear), a band of A == 1, partial A elsewhere with a
+  // Target: a band of A == 0 (whole blocks clear: the CPU lanes' copy), a band of A == 1, partial A elsewhere with a
   // sprinkle of 0 and 1; keys: the block's nearest eye depth (the march's), some sky.
   const int projection = int(cam.projection);
   const float zx = cam.zbuffer_params.x, zy = cam.zbuffer_params.y, near_plane = cam.near_plane(),
@@ -124,7 +126,8 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
       const std::size_t i = std::size_t(ly) * low_width + lx;
       const int band = ly * 4 / low_height;  // 0..3 down the frame
       float a = unit(rng);
-      if (band == 0 || (lx + ly) % 9 == 0) a = 0.0f;
+      if (band == 0) a = 0.0f;
+      if ((lx + ly) % 9 == 0) a = lx % 2 ? -0.0f : 0.0f;  // -0 takes the CPU lanes' full path
       if (band == 1 || (lx + ly) % 9 == 4) a = 1.0f;
       for (int k = 0; k < 3; ++k) low[4 * i + k] = a * unit(rng);
       low[4 * i + 3] = a;
@@ -142,6 +145,8 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   frame[VOL_F_ZY] = zy;
   frame[VOL_F_NEAR] = near_plane;
   frame[VOL_F_FAR] = far_plane;
+  frame[VOL_F_INV_NEAR] = 1.0f / near_plane;
+  frame[VOL_F_INV_FAR] = 1.0f / far_plane;
 
   // The kernel, built with the options the pass would use for such a device.
   detail::VolumeVariant variant;
@@ -188,10 +193,9 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const std::size_t i = std::size_t(y) * width + x;
-      const float key = c.depth_aware && s > 1 ? vol_eye_depth<float>(depth.data()[i], projection, reversed, zx, zy,
-                                                                       near_plane, far_plane)
-                                               : 0.0f;
-      const glm::vec4 fog = vol_upsample<float>(x, y, key, low.data(), low_key.data(), low_width, low_height, s,
+      const float rho =
+          c.depth_aware && s > 1 ? vol_inverse_eye_depth<float>(depth.data()[i], frame.data(), projection, reversed) : 0.0f;
+      const glm::vec4 fog = vol_upsample<float>(x, y, rho, low.data(), low_key.data(), low_width, low_height, s,
                                                 c.depth_aware);
       if (fog.w == 0.0f) {
         ++clear;
@@ -221,6 +225,75 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, VolumeCompositeKernel, testing::ValuesIn(all_cases()), name_of);
+
+// The sky test on Linear01Depth's denominator q is DESIGN.md §2's on 1 / q: float 1 / q rounds
+// monotonically, so the threshold and the float below it decide every q.
+TEST(VolumeDepthSimilarity, SkyDenominatorIsTheSkyTest) {
+  using namespace volume_formulas;
+  const float t = VOL_SKY_DENOMINATOR, below = std::nextafter(t, 0.0f);
+  std::printf("  threshold %a: 1/q %a (sky %d), below %a: 1/q %a (sky %d)\n", t, 1.0f / t, fog_is_sky(1.0f / t), below,
+              1.0f / below, fog_is_sky(1.0f / below));
+  EXPECT_FALSE(fog_is_sky(1.0f / t));
+  EXPECT_TRUE(fog_is_sky(1.0f / below));
+}
+
+// A pixel's inverse eye depth against the key the march derives from the same depth (its eye
+// depth): differences near 0 on surfaces (the two roundings), exactly 0 for sky against sky and 1
+// for sky against a surface, in every projection and at stiff far / near ratios.
+TEST(VolumeDepthSimilarity, OwnDepthIsSimilarAndSkyIsNot) {
+  using namespace volume_formulas;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  float worst = 0.0f;
+  for (View view : {View::conventional, View::reversed, View::infinite_far, View::orthographic})
+    for (float far_plane : {100.0f, 1e6f, 1e9f}) {
+      CameraParams cam = camera_of(view, 16, 9);
+      if (view == View::orthographic) {
+        OrthographicCamera o;
+        o.far_plane = far_plane;
+        cam = make_camera_params(o);
+      } else if (view != View::infinite_far) {
+        PerspectiveCamera p;
+        p.near_plane = 0.01f;
+        p.far_plane = far_plane;
+        p.reversed_z = view == View::reversed;
+        cam = make_camera_params(p);
+      }
+      std::array<float, VOL_F_COUNT> frame{};
+      frame[VOL_F_ZX] = cam.zbuffer_params.x;
+      frame[VOL_F_ZY] = cam.zbuffer_params.y;
+      frame[VOL_F_NEAR] = cam.near_plane();
+      frame[VOL_F_FAR] = cam.far_plane();
+      frame[VOL_F_INV_NEAR] = 1.0f / cam.near_plane();
+      frame[VOL_F_INV_FAR] = 1.0f / cam.far_plane();
+      const int projection = int(cam.projection);
+      const auto eye = [&](float raw) {
+        return vol_eye_depth<float>(raw, projection, cam.reversed_z, frame[VOL_F_ZX], frame[VOL_F_ZY],
+                                    frame[VOL_F_NEAR], frame[VOL_F_FAR]);
+      };
+      const float sky_raw = cam.reversed_z ? 0.0f : 1.0f, sky_key = eye(sky_raw);
+      const float sky_rho = vol_inverse_eye_depth<float>(sky_raw, frame.data(), projection, cam.reversed_z);
+      ASSERT_EQ(sky_key, std::numeric_limits<float>::infinity());
+      EXPECT_EQ(vol_depth_difference(sky_rho, sky_key), 0.0f);
+      EXPECT_EQ(vol_depth_difference(sky_rho, std::numeric_limits<float>::quiet_NaN()), 0.0f);
+      for (int n = 0; n < 2000; ++n) {
+        const float raw = unit(rng), key = eye(raw);
+        const float rho = vol_inverse_eye_depth<float>(raw, frame.data(), projection, cam.reversed_z);
+        if (key == std::numeric_limits<float>::infinity()) {
+          EXPECT_EQ(vol_depth_difference(rho, key), 0.0f) << raw;
+          continue;
+        }
+        worst = std::max(worst, vol_depth_difference(rho, key));
+        EXPECT_EQ(vol_depth_difference(rho, sky_key), 1.0f) << raw;
+        EXPECT_EQ(vol_depth_difference(sky_rho, key), 1.0f) << raw;
+        // Half and twice the depth: the difference is relative to the pixel's own depth.
+        EXPECT_NEAR(vol_depth_difference(rho, 0.5f * key), 0.5f, 1e-5f) << raw;
+        EXPECT_EQ(vol_depth_difference(rho, 2.5f * key), 1.0f) << raw;
+      }
+    }
+  std::printf("  worst difference of a pixel's own depth: %.3g (relative; EPS is 0.01)\n", worst);
+  EXPECT_LT(worst, 1e-5f);
+}
 
 }  // namespace
 }  // namespace fogcl::test

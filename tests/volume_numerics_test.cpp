@@ -133,7 +133,7 @@ TEST(VolumeUpsampling, DepthAwareBeatsBilinearAtSilhouettes) {
     }
     std::printf("  1/%d resolution: mean |error| per pixel against full resolution: depth-aware %.4g, bilinear %.4g\n",
                 divisor, err[0], err[1]);
-    EXPECT_LT(err[0], 0.8 * err[1]);
+    EXPECT_LT(err[0], 0.85 * err[1]);  // measured: 0.799 at 1/2, 0.794 at 1/4
   }
 }
 

@@ -298,6 +298,8 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   for (int c = 0; c < 4; ++c) put3(VOL_F_CORNERS + 3 * c, camera.frustum_corners[c]);
   k[VOL_F_NEAR] = camera.near_plane();
   k[VOL_F_FAR] = camera.far_plane();
+  k[VOL_F_INV_NEAR] = 1.0f / k[VOL_F_NEAR];
+  k[VOL_F_INV_FAR] = 1.0f / k[VOL_F_FAR];
   k[VOL_F_ZX] = camera.zbuffer_params.x;
   k[VOL_F_ZY] = camera.zbuffer_params.y;
   k[VOL_F_CORNER_Z] = camera.frustum_corners[kBottomLeft].z;

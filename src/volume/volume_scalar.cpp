@@ -59,12 +59,10 @@ VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, co
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * w + x;
-      const T key = v.depth_aware && v.scale > 1
-                        ? vol_eye_depth(T(depth.data()[i]), projection, reversed, T(k[VOL_F_ZX]), T(k[VOL_F_ZY]),
-                                        T(k[VOL_F_NEAR]), T(k[VOL_F_FAR]))
-                        : T(0);
+      const T rho = v.depth_aware && v.scale > 1 ? vol_inverse_eye_depth(T(depth.data()[i]), k, projection, reversed)
+                                                 : T(0);
       const glm::vec<4, T> fog =
-          vol_upsample(x, y, key, r.low.data(), r.low_key.data(), f.low_width, f.low_height, v.scale, v.depth_aware);
+          vol_upsample(x, y, rho, r.low.data(), r.low_key.data(), f.low_width, f.low_height, v.scale, v.depth_aware);
       r.coverage[i] = fog.w;
       if (fog.w == T(0)) continue;
       for (int c = 0; c < 3; ++c) r.rgba[4 * i + c] = vol_composite(r.rgba[4 * i + c], fog[c], fog.w);
