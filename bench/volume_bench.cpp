@@ -28,7 +28,9 @@
 //        1080p half resolution (noise buffer) in both storages (RGBA32F, RGBA16F) and both
 //        upsamplings (depth-aware, bilinear); sparse 1: the scene without the haze around the camera
 //        (the other three volumes cover part of the frame, and blocks with no coverage are copies)
-// BM_VolumeDevice and BM_VolumeComposite also time a 2-thread memcpy of the frame's color (in its
+//   BM_VolumeCompositeKernel/f16/bilinear   the same kernel alone, dispatched back to back on a
+//        fixed target (the scalar march of the stylized scene): hundreds of iterations, for A/B
+// BM_VolumeDevice, BM_VolumeComposite and BM_VolumeCompositeKernel also time a 2-thread memcpy of the frame's color (in its
 // storage) and depth (memcpy2_ms) for composite_vs_memcpy2 = composite time / that copy.
 // Widths: 480 (480x270: scalar and OpenCL in the same run) and 1920 (1080p, OpenCL only).
 #include <algorithm>
@@ -50,6 +52,7 @@
 #include "runtime/clhpp.h"
 #include "volume/volume_formulas.h"
 #include "volume/volume_params.h"
+#include "volume_composite_cl.h"
 #include "volume_openmp_peer.h"
 
 namespace {
@@ -261,6 +264,58 @@ void BM_VolumeComposite(benchmark::State& state) {
   pass_counters(state, march_ms / n, composite_ms / n, d.input, f.depth);
 }
 
+// The upsample + composite kernel alone, dispatched back to back on one fixed target: the scalar
+// march of the demo scene (stylized, 1080p half), built once. Hundreds of iterations instead of
+// BM_VolumeComposite's two (each of which marches the frame again), for A/B of the kernel's code.
+void BM_VolumeCompositeKernel(benchmark::State& state) {
+  const ColorFormat storage = state.range(0) ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+  const DemoFrame& f = frame(1920);
+  VolumeSettings st = settings(VolumeIntegrator::stylized, 2, false);
+  st.upsampling = state.range(1) ? VolumeUpsampling::bilinear : VolumeUpsampling::depth_aware;
+  const VolumeScene s = scene(VolumeIntegrator::stylized);
+  static const VolumeResult<float> target = volumes_scalar<float>(f.color, f.depth, f.params, s, st);
+  const detail::PackedVolumeFrame packed = detail::pack_volume_frame(
+      f.color.width(), f.color.height(), f.params, s, st, storage, nullptr, 0, 0, max_eye_depth(f.depth, f.params));
+
+  const cl::Device device = wrap(runtime().device());
+  const cl::Context ctx = wrap(runtime().context());
+  DeviceTraits traits;
+  traits.cpu = device_is_cpu(device());
+  traits.opencl_c_version = device_opencl_c_version(device());
+  traits.cache_bytes = device_cache_bytes(device());
+  const std::string options = detail::volume_composite_options(packed.variant, traits);
+  cl::Program program(ctx, std::string(volume_composite_cl));
+  if (program.build({device}, options.c_str()) != CL_SUCCESS) {
+    state.SkipWithError(program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device).c_str());
+    return;
+  }
+  cl::Kernel kernel(program, "volume_composite");
+  const ColorImage input = convert(f.color, storage);
+  const auto buffer = [&](const void* p, std::size_t bytes) {
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(p));
+  };
+  const cl::Buffer in = buffer(input.data(), input.size_bytes()), d = buffer(f.depth.data(), f.depth.size_bytes());
+  const cl::Buffer k = buffer(packed.frame.data(), sizeof(packed.frame));
+  const cl::Buffer low = buffer(target.low.data(), target.low.size() * 4);
+  const cl::Buffer key = buffer(target.low_key.data(), target.low_key.size() * 4);
+  const cl::Buffer out(ctx, CL_MEM_WRITE_ONLY, input.size_bytes());
+  int arg = 0;
+  for (const cl::Buffer* b : {&in, &d, &out, &k, &low, &key}) kernel.setArg(arg++, *b);
+  const cl::CommandQueue queue(ctx, device, CL_QUEUE_PROFILING_ENABLE);
+  const int lanes = pixels_per_work_item(traits);
+  const cl::NDRange global((f.color.width() + lanes - 1) / lanes, f.color.height());
+  double total_ms = 0;
+  for (auto _ : state) {
+    cl::Event done;
+    queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, cl::NullRange, nullptr, &done);
+    done.wait();
+    const double ms = event_ms(done, CL_PROFILING_COMMAND_START, done, CL_PROFILING_COMMAND_END);
+    total_ms += ms;
+    state.SetIterationTime(ms * 1e-3);
+  }
+  pass_counters(state, 0.0, total_ms / double(state.iterations()), input, f.depth);
+}
+
 void BM_VolumeHostCall(benchmark::State& state) {
   const auto integrator = VolumeIntegrator(state.range(0));
   const int divisor = int(state.range(1)), width = int(state.range(3));
@@ -406,6 +461,12 @@ BENCHMARK(BM_VolumeComposite)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(2);  // each iteration marches the frame again (1-2 s)
+BENCHMARK(BM_VolumeCompositeKernel)
+    ->ArgNames({"f16", "bilinear"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
 BENCHMARK(BM_VolumeHostCall)
     ->ArgNames({"integrator", "divisor", "noise_image", "width"})
     ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}, {1920}})

@@ -83,7 +83,7 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL
   /* Depth-aware weights are bilinear[k] / e[k], e[k] = EPS + depth difference in [0.01, 1.01],
    * here scaled by e0 e1 e2 e3 (the sum is normalised): products that cannot overflow or
    * underflow instead of 4 divisions, and one reciprocal of their sum. Bilinear weights sum to
-   * exactly 1 at s = 2 and 4. */
+   * exactly 1 at s = 2 and 4: no normalisation. */
   if (depth_aware) {
     VOL_REAL e[4];
     for (int k = 0; k < 4; ++k)
@@ -94,16 +94,15 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL
     w[1] = w[1] * (e[0] * e23);
     w[2] = w[2] * (e[3] * e01);
     w[3] = w[3] * (e[2] * e01);
-    const VOL_REAL norm = (VOL_REAL)1 / ((VOL_REAL)0 + w[0] + w[1] + w[2] + w[3]);
-    for (int k = 0; k < 4; ++k) w[k] = w[k] * norm;
   }
-  VOL_V4 sum = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  VOL_V4 tap[4];
   for (int k = 0; k < 4; ++k) {
     const size_t i = (size_t)ys[k] * (size_t)low_width + (size_t)xs[k];
-    const VOL_V4 tap = VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3));
-    sum = k == 0 ? tap * w[0] : VOL_T(vol_fma4)(tap, w[k], sum);
+    tap[k] = VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3));
   }
-  return sum;
+  /* Row by row, then normalised: two short chains, and the CPU lanes' division overlaps them. */
+  const VOL_V4 sum = VOL_T(vol_fma4)(tap[1], w[1], tap[0] * w[0]) + VOL_T(vol_fma4)(tap[3], w[3], tap[2] * w[2]);
+  return depth_aware ? sum * ((VOL_REAL)1 / ((w[0] + w[1]) + (w[2] + w[3]))) : sum;
 }
 
 /* One channel over the fog (docs/volumetric.md §Resolution, upsampling, composite): P + c (1 - A),

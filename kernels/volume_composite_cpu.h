@@ -186,7 +186,7 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   }
   float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
 #if VOL_DEPTH_AWARE
-  /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), normalised by one
+  /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), and one
    * reciprocal of their sum per pixel. */
   const float16 rho = vol_inverse_eye_depth_v(vload16(0, depth + i0), frame);
   const float16 top_keys = vol_capped_keys_v(vol_window_keys(low_key, top, b, low_width, inside));
@@ -200,26 +200,27 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   w1 = w1 * (e0 * e23);
   w2 = w2 * (e3 * e01);
   w3 = w3 * (e2 * e01);
-  const float16 norm = 1.0f / (0.0f + w0 + w1 + w2 + w3);
-  w0 = w0 * norm;
-  w1 = w1 * norm;
-  w2 = w2 * norm;
-  w3 = w3 * norm;
+  const float16 norm = 1.0f / ((w0 + w1) + (w2 + w3));
+#define VOL_NORMALISE(sum, q) ((sum) * VOL_QUAD_SPREAD(norm, q))
+#else
+#define VOL_NORMALISE(sum, q) (sum) /* the bilinear weights sum to exactly 1 */
 #endif
-  /* The taps in vol_upsample's order: top left, top right, bottom left, bottom right. */
-#define VOL_QUAD(q, t, u)                                                                    \
-  {                                                                                          \
-    float16 sum = VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q);                    \
-    sum = fma(VOL_SHUFFLE(t, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w1, q), sum);                  \
-    sum = fma(VOL_SHUFFLE(u, VOL_QUAD_LEFT), VOL_QUAD_SPREAD(w2, q), sum);                   \
-    sum = fma(VOL_SHUFFLE(u, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w3, q), sum);                  \
-    vol_composite_quad(in, out, q, sum, stream);                                             \
+  /* vol_upsample's sum: the top row's taps, the bottom row's, their sum, normalised (the
+   * normalisation last, so the division's latency overlaps the taps' arithmetic). */
+#define VOL_QUAD(q, t, u)                                                                     \
+  {                                                                                           \
+    const float16 top_taps = fma(VOL_SHUFFLE(t, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w1, q),      \
+                                 VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q));      \
+    const float16 bottom_taps = fma(VOL_SHUFFLE(u, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w3, q),   \
+                                    VOL_SHUFFLE(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q));   \
+    vol_composite_quad(in, out, q, VOL_NORMALISE(top_taps + bottom_taps, q), stream);         \
   }
   VOL_QUAD(0, t0, u0)
   VOL_QUAD(1, t1, u1)
   VOL_QUAD(2, t2, u2)
   VOL_QUAD(3, t3, u3)
 #undef VOL_QUAD
+#undef VOL_NORMALISE
 #endif
 }
 
