@@ -18,18 +18,6 @@
 #define FOG_SHUFFLE(a, b, ...) shuffle2((a), (b), (uint16)(__VA_ARGS__))
 #endif
 
-/* The bitwise or of a uint16's lanes, as one reduction: PoCL lowers OpenCL's any() on a
- * 16-lane vector to 16 tests and branches, one per lane. */
-#ifdef __clang__
-#define FOG_REDUCE_OR16(v) __builtin_reduce_or(v)
-#else
-#define FOG_REDUCE_OR16(v) fog_reduce_or16(v)
-static inline uint fog_reduce_or16(uint16 v) {
-  const uint4 q = v.s0123 | v.s4567 | v.s89ab | v.scdef;
-  return q.x | q.y | q.z | q.w;
-}
-#endif
-
 /* Streaming stores (FOG_STREAMING_MIN_PIXELS, docs/DESIGN.md §3). FOG_STREAMS(width, height):
  * whether a frame's RGBA32F output is written with non-temporal stores. FOG_STREAM_OR(bits, p,
  * stream, ordinary): the 16 words `bits` (uint16) go to p (global uint*) with a non-temporal store

@@ -55,7 +55,16 @@
 #define VOL_INT int
 #define VOL_TO_INT(x) int(x)
 #endif
-#define VOL_ANY(m) (m) /* the lanes instance: any(m) */
+#define VOL_ANY(m) (m) /* the lanes instance: VOL_ANY16(m) */
+#ifdef __OPENCL_C_VERSION__
+/* any(m) of a 16-lane mask (lanes -1 / 0) as one or-reduction: PoCL lowers OpenCL's any() on 16
+ * lanes to a test and a branch per lane. */
+#ifdef __clang__
+#define VOL_ANY16(m) (__builtin_reduce_or(m) < 0)
+#else
+#define VOL_ANY16(m) any(m)
+#endif
+#endif
 
 /* A packed parameter, read in the path's precision. */
 #define VOL_P(array, index) ((VOL_REAL)(array)[index])

@@ -110,7 +110,7 @@ static inline void vol_copy_quad(global const COLOR_T* in, global COLOR_T* out, 
  * the input through. -0 and NaN coverages take the full path, which gives them the same bits. */
 static inline int vol_fogless(float16 t0, float16 t1, float16 t2, float16 t3) {
   const uint16 bits = (as_uint16(t0) | as_uint16(t1) | as_uint16(t2) | as_uint16(t3)) & as_uint16(VOL_ALPHA_LANES);
-  return FOG_REDUCE_OR16(bits) == 0u;
+  return !VOL_ANY16(bits != 0u);
 }
 
 /* Quad q of the block as bits: the composite where 0 < A, the input's bits where A == 0 and in

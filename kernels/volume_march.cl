@@ -115,7 +115,7 @@ static inline __attribute__((always_inline)) vol_float4x16 vol_texel_row_x16(glo
   }
   uint16 second = vload16(0, hi);
   const int16 wrapped = x1 != x0 + 1;
-  if (any(wrapped)) {
+  if (VOL_ANY16(wrapped)) {
     int far[16];
     vstore16(row + x1, 0, far);
     for (int k = 0; k < 16; ++k) hi[k] = words[far[k]];
@@ -178,7 +178,7 @@ static inline __attribute__((overloadable)) float16 vol_shadow_lit(vol_float3x16
 #define VOL_MAKE4 vol_make4_x16
 #define VOL_INT int16
 #define VOL_TO_INT(x) convert_int16(x)
-#define VOL_ANY(m) any(m)
+#define VOL_ANY(m) VOL_ANY16(m)
 #define VOL_UINT uint16
 #define VOL_TEXEL_PLANE_R(tex, n, x0, y0, z, fx, fy) vol_texel_plane_r_x16((tex), (n), (x0), (y0), (z), (fx), (fy))
 #define VOL_TEXEL_ROW(tex, n, x0, x1, y, z, fx) vol_texel_row_x16((tex), (n), (x0), (x1), (y), (z), (fx))
@@ -248,7 +248,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     const float16 front16 = vload16(0, front);
     float16 reach = vol_stylized_reach(front16, vload16(0, back), t_scene, VOL_PU(vol, VOL_V_OVERSHOOT));
     const int16 active = vload16(0, enters) && reach > 0.0f;
-    if (!any(active)) continue;
+    if (!VOL_ANY16(active)) continue;
     reach = active ? reach : 0.0f;
     float16 accumulation, shadowed, marched;
     vol_stylized_march(origin, dir, front16, reach, jitter16, vol, frame, noise, noise_size, shadow_map, VOL_STEPS,
@@ -287,7 +287,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   float16 i_r = 0.0f, i_g = 0.0f, i_b = 0.0f, optical = 0.0f;
   for (;;) {
     const int16 alive = vload16(0, live);
-    if (!any(alive)) break;
+    if (!VOL_ANY16(alive)) break;
     const float16 pa = alive ? vload16(0, a) : 0.0f, pb = alive ? vload16(0, b) : 0.0f;
     const float16 pn = alive ? vload16(0, n) : 1.0f, pj = vload16(0, j);
     const float16 length = pb - pa;
@@ -303,7 +303,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     const float16 sigma_t = vol_physical_sample(p, t, cos16, lit, volumes_here, volumes, count, frame, noise,
                                                 noise_size, VOL_FEATURES, &source);
     const int16 adds = sigma_t > 0.0f;
-    if (any(adds)) {
+    if (VOL_ANY16(adds)) {
       const float16 scatter = vol_segment_weight(sigma_t, seg, optical, VOL_INTEGRATOR == VOL_RIEMANN);
       i_r = adds ? i_r + source.x * scatter : i_r;
       i_g = adds ? i_g + source.y * scatter : i_g;
@@ -312,7 +312,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     }
     vstore16(pj + 1.0f, 0, j);
     const int16 piece_ends = alive && pj + 1.0f == pn;
-    if (!any(piece_ends)) continue;
+    if (!VOL_ANY16(piece_ends)) continue;
     int ends[16];
     vstore16(piece_ends, 0, ends);
     for (int k = 0; k < 16; ++k)
