@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
 #include <sstream>
 
@@ -18,7 +19,10 @@
 #include "fogcl/version.h"
 #include "runtime/clhpp.h"
 
+#include "deferred_fog_cl.h"      // the kernels' text, headers included (generated)
 #include "plot_common_py.h"  // generated from report/plot_common.py
+#include "volume_composite_cl.h"
+#include "volume_march_cl.h"
 
 namespace fogcl::report_detail {
 
@@ -145,25 +149,39 @@ std::string default_cache_dir() {
   return (fs::temp_directory_path() / "fogcl-cache").string();
 }
 
+namespace {
+
+// FNV-1a 64 of the parts, each followed by a separator byte, as 16 hex digits.
+std::string fnv1a_hex(std::initializer_list<const char*> parts) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const char* s : parts) {
+    for (; *s != '\0'; ++s) h = (h ^ static_cast<unsigned char>(*s)) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+}  // namespace
+
 DeviceKey device_key(const Runtime& runtime) {
+  // The kernels' text is part of the version: measured errors and times belong to the kernels
+  // that were measured, and a development build changes them without a new version number.
+  static const std::string version =
+      std::string(library_version()) + "+kernels." + fnv1a_hex({deferred_fog_cl, volume_march_cl, volume_composite_cl});
   return with_cl_errors([&] {
     const cl::Device d = wrap(runtime.device());
     const cl::Platform platform(d.getInfo<CL_DEVICE_PLATFORM>());
     return DeviceKey{d.getInfo<CL_DEVICE_NAME>() + " (" + platform.getInfo<CL_PLATFORM_NAME>() + ")",
-                     d.getInfo<CL_DRIVER_VERSION>(), library_version()};
+                     d.getInfo<CL_DRIVER_VERSION>(), version};
   });
 }
 
 std::string cache_file_name(const std::string& prefix, const DeviceKey& k, const std::string& extra) {
-  std::uint64_t h = 1469598103934665603ull;  // FNV-1a 64
-  for (const std::string* s : {&k.device, &k.driver, &k.version, &extra}) {
-    if (s == &extra && extra.empty()) break;  // the deferred budget's names stay as they were
-    for (unsigned char c : *s) h = (h ^ c) * 1099511628211ull;
-    h = (h ^ 0xff) * 1099511628211ull;  // separator
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return prefix + "-" + buf + ".csv";
+  const std::string hash = extra.empty() ? fnv1a_hex({k.device.c_str(), k.driver.c_str(), k.version.c_str()})
+                                         : fnv1a_hex({k.device.c_str(), k.driver.c_str(), k.version.c_str(), extra.c_str()});
+  return prefix + "-" + hash + ".csv";
 }
 
 std::string one_line(std::string s) {

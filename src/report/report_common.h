@@ -63,7 +63,8 @@ void run_plot_script(const std::string& dir, const std::string& python, const ch
 
 // $XDG_CACHE_HOME/fogcl, else ~/.cache/fogcl, else <tmp>/fogcl-cache.
 std::string default_cache_dir();
-// The device's identity for a cache: "name (platform)", driver version, library version.
+// The device's identity for a cache: "name (platform)", driver version, library version with the
+// kernels' digest ("0.1.0+kernels.<FNV-1a 64 of their text>").
 struct DeviceKey {
   std::string device, driver, version;
 };
