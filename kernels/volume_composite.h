@@ -1,5 +1,6 @@
 /* volume_composite.h — the target back to full resolution and over the frame
- * (docs/volumetric.md §Resolution, upsampling, composite). Needs volume_common.h. */
+ * (docs/volumetric.md §Resolution, upsampling, composite). Needs volume_common.h and the
+ * one-pixel instance of fog_math.h (the depth formulas). */
 
 /* Weight floor of the depth-aware upsampling: a tap's weight is its bilinear weight over
  * (VOL_UPSAMPLE_EPS + depth difference), so taps on the pixel's own surface win about 50 : 1 over
