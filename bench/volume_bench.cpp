@@ -189,13 +189,16 @@ double march_work(const DemoFrame& f, const VolumeScene& s, const VolumeSettings
 
 // The march's and the composite's mean ms per frame, and the composite against a 2-thread
 // memcpy of the frame's color (in its storage) and depth.
+void composite_counters(benchmark::State& state, double composite_ms, double copy_ms) {
+  state.counters["composite_ms"] = composite_ms;
+  state.counters["memcpy2_ms"] = copy_ms;
+  state.counters["composite_vs_memcpy2"] = composite_ms / copy_ms;
+}
+
 void pass_counters(benchmark::State& state, double march_ms, double composite_ms, const ColorImage& color,
                    const DepthImage& depth) {
   state.counters["march_ms"] = march_ms;
-  state.counters["composite_ms"] = composite_ms;
-  const double copy_ms = memcpy2_ms(color, depth);
-  state.counters["memcpy2_ms"] = copy_ms;
-  state.counters["composite_vs_memcpy2"] = composite_ms / copy_ms;
+  composite_counters(state, composite_ms, memcpy2_ms(color, depth));
 }
 
 // A prepared pass and the frame's buffers in device memory on a profiling queue, as a renderer
@@ -300,10 +303,7 @@ void BM_VolumeCompositeKernel(benchmark::State& state) {
 
   const cl::Device device = wrap(runtime().device());
   const cl::Context ctx = wrap(runtime().context());
-  DeviceTraits traits;
-  traits.cpu = device_is_cpu(device());
-  traits.opencl_c_version = device_opencl_c_version(device());
-  traits.cache_bytes = device_cache_bytes(device());
+  const DeviceTraits traits = device_traits(device());
   const std::string options = detail::volume_composite_options(packed.variant, traits);
   cl::Program program(ctx, std::string(volume_composite_cl));
   if (program.build({device}, options.c_str()) != CL_SUCCESS) {
@@ -340,9 +340,7 @@ void BM_VolumeCompositeKernel(benchmark::State& state) {
     copy_ms.push_back(copy.once());
     state.ResumeTiming();
   }
-  state.counters["composite_ms"] = median(composite_ms);
-  state.counters["memcpy2_ms"] = median(copy_ms);
-  state.counters["composite_vs_memcpy2"] = median(composite_ms) / median(copy_ms);
+  composite_counters(state, median(composite_ms), median(copy_ms));
 }
 
 void BM_VolumeHostCall(benchmark::State& state) {

@@ -27,6 +27,14 @@ typedef ushort vol_v16h_u __attribute__((__vector_size__(32), aligned(2)));
 #define VOL_STORE16U(value, p) vstore16((value), 0, (p))
 #define VOL_STORE16H(value, p) vstore16((value), 0, (p))
 #endif
+/* Quad q of the block's output, as bits (ushort16 of half storage, uint16 of float storage): RGBA32F
+ * with streaming stores where the frame takes them (a macro, as FOG_STREAM_OR must stay). */
+#ifdef FOG_COLOR_HALF
+#define VOL_STORE_QUAD(bits, out, q, stream) VOL_STORE16H((bits), (global ushort*)(out) + 16 * (q))
+#else
+#define VOL_STORE_QUAD(bits, out, q, stream) \
+  FOG_STREAM_OR((bits), (global uint*)(out) + 16 * (q), (stream), VOL_STORE16U((bits), (global uint*)(out) + 16 * (q)))
+#endif
 
 #define VOL_LANE_INDEX (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
 /* Shuffle masks (literal constants: one permute each, FOG_SHUFFLE). L_j, and within a quad's
@@ -98,11 +106,11 @@ static inline __attribute__((always_inline)) float16 vol_window_keys(global cons
 /* Quad q of the block unchanged: the pass-through of a quad with no fog, as bits. */
 static inline void vol_copy_quad(global const COLOR_T* in, global COLOR_T* out, uint q, int stream) {
 #ifdef FOG_COLOR_HALF
-  VOL_STORE16H(vload16(q, (global const ushort*)in), (global ushort*)out + 16 * q);
+  const ushort16 bits = vload16(q, (global const ushort*)in);
 #else
   const uint16 bits = vload16(q, (global const uint*)in);
-  FOG_STREAM_OR(bits, (global uint*)out + 16 * q, stream, VOL_STORE16U(bits, (global uint*)out + 16 * q));
 #endif
+  VOL_STORE_QUAD(bits, out, q, stream);
 }
 
 /* Whether none of the (P, A) quads of a block's window has fog: every coverage is +0, so every
@@ -136,13 +144,13 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
   vstore_half16_rte(o, 0, (half*)staged);
   const ushort16 rounded = vload16(0, staged);
 #endif
-  VOL_STORE16H(select(rounded, bits, convert_short16(keep)), (global ushort*)out + 16 * q);
+  VOL_STORE_QUAD(select(rounded, bits, convert_short16(keep)), out, q, stream);
 #else
   const uint16 bits = vload16(q, (global const uint*)in);
   const float16 c = as_float16(bits);
   const float16 o = select(fma(c, 1.0f - a, fog), fog, a == 1.0f);
   const uint16 result = select(as_uint16(o), bits, keep);
-  FOG_STREAM_OR(result, (global uint*)out + 16 * q, stream, VOL_STORE16U(result, (global uint*)out + 16 * q));
+  VOL_STORE_QUAD(result, out, q, stream);
 #endif
 }
 
@@ -225,6 +233,7 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
 }
 
 #undef VOL_LANE_INDEX
+#undef VOL_STORE_QUAD
 #undef VOL_QUAD_SPREAD
 #undef VOL_QUAD_ALPHA
 #undef VOL_ALPHA_LANES

@@ -141,12 +141,7 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   frame[VOL_F_SCALE] = float(s);
   frame[VOL_F_LOW_WIDTH] = float(low_width);
   frame[VOL_F_LOW_HEIGHT] = float(low_height);
-  frame[VOL_F_ZX] = zx;
-  frame[VOL_F_ZY] = zy;
-  frame[VOL_F_NEAR] = near_plane;
-  frame[VOL_F_FAR] = far_plane;
-  frame[VOL_F_INV_NEAR] = 1.0f / near_plane;
-  frame[VOL_F_INV_FAR] = 1.0f / far_plane;
+  detail::pack_depth_constants(frame.data(), cam);
 
   // The kernel, built with the options the pass would use for such a device.
   detail::VolumeVariant variant;
@@ -260,12 +255,7 @@ TEST(VolumeDepthSimilarity, OwnDepthIsSimilarAndSkyIsNot) {
         cam = make_camera_params(p);
       }
       std::array<float, VOL_F_COUNT> frame{};
-      frame[VOL_F_ZX] = cam.zbuffer_params.x;
-      frame[VOL_F_ZY] = cam.zbuffer_params.y;
-      frame[VOL_F_NEAR] = cam.near_plane();
-      frame[VOL_F_FAR] = cam.far_plane();
-      frame[VOL_F_INV_NEAR] = 1.0f / cam.near_plane();
-      frame[VOL_F_INV_FAR] = 1.0f / cam.far_plane();
+      detail::pack_depth_constants(frame.data(), cam);
       const int projection = int(cam.projection);
       const auto eye = [&](float raw) {
         return vol_eye_depth<float>(raw, projection, cam.reversed_z, frame[VOL_F_ZX], frame[VOL_F_ZY],

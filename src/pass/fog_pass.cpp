@@ -58,10 +58,7 @@ FogPass::FogPass(cl_context context, cl_device_id device, std::shared_ptr<Progra
   if (programs->context() != context)
     throw Error("FogPass: the shared ProgramCache belongs to another OpenCL context than the pass");
   m.programs = std::move(programs);
-  m.traits.codegen = codegen;
-  m.traits.cpu = device_is_cpu(device);
-  m.traits.opencl_c_version = device_opencl_c_version(device);
-  m.traits.cache_bytes = device_cache_bytes(device);
+  m.traits = device_traits(device, codegen);
 }
 
 FogPass::FogPass(const Runtime& runtime, const CpuCodegen& codegen, std::shared_ptr<ProgramCache> programs)

@@ -11,9 +11,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <initializer_list>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 #include "fogcl/error.h"
 #include "fogcl/version.h"
@@ -152,7 +152,7 @@ std::string default_cache_dir() {
 namespace {
 
 // FNV-1a 64 of the parts, each followed by a separator byte, as 16 hex digits.
-std::string fnv1a_hex(std::initializer_list<const char*> parts) {
+std::string fnv1a_hex(const std::vector<const char*>& parts) {
   std::uint64_t h = 1469598103934665603ull;
   for (const char* s : parts) {
     for (; *s != '\0'; ++s) h = (h ^ static_cast<unsigned char>(*s)) * 1099511628211ull;
@@ -179,9 +179,9 @@ DeviceKey device_key(const Runtime& runtime) {
 }
 
 std::string cache_file_name(const std::string& prefix, const DeviceKey& k, const std::string& extra) {
-  const std::string hash = extra.empty() ? fnv1a_hex({k.device.c_str(), k.driver.c_str(), k.version.c_str()})
-                                         : fnv1a_hex({k.device.c_str(), k.driver.c_str(), k.version.c_str(), extra.c_str()});
-  return prefix + "-" + hash + ".csv";
+  std::vector<const char*> parts{k.device.c_str(), k.driver.c_str(), k.version.c_str()};
+  if (!extra.empty()) parts.push_back(extra.c_str());  // the deferred budget's names stay as they were
+  return prefix + "-" + fnv1a_hex(parts) + ".csv";
 }
 
 std::string one_line(std::string s) {

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "fogcl/error.h"
+#include "fogcl/runtime.h"
 
 namespace fogcl {
 
@@ -32,6 +33,15 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
   v.storage = storage;
   v.precision = s.precision;
   return v;
+}
+
+DeviceTraits device_traits(cl_device_id device, const CpuCodegen& codegen) {
+  DeviceTraits traits;
+  traits.cpu = device_is_cpu(device);
+  traits.opencl_c_version = device_opencl_c_version(device);
+  traits.cache_bytes = device_cache_bytes(device);
+  traits.codegen = codegen;
+  return traits;
 }
 
 int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }

@@ -213,6 +213,15 @@ namespace detail {
 
 bool PackedVolumeFrame::needs_noise() const { return (variant.features & VOL_FEATURE_NOISE) != 0; }
 
+void pack_depth_constants(float* frame, const CameraParams& camera) {
+  frame[VOL_F_NEAR] = camera.near_plane();
+  frame[VOL_F_FAR] = camera.far_plane();
+  frame[VOL_F_INV_NEAR] = 1.0f / frame[VOL_F_NEAR];
+  frame[VOL_F_INV_FAR] = 1.0f / frame[VOL_F_FAR];
+  frame[VOL_F_ZX] = camera.zbuffer_params.x;
+  frame[VOL_F_ZY] = camera.zbuffer_params.y;
+}
+
 PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& camera, const VolumeScene& scene,
                                     const VolumeSettings& settings, ColorFormat storage,
                                     const ShadowMapParams* shadow, int shadow_width, int shadow_height,
@@ -296,12 +305,7 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   put3(VOL_F_UP, b.up);
   put3(VOL_F_FORWARD, b.forward);
   for (int c = 0; c < 4; ++c) put3(VOL_F_CORNERS + 3 * c, camera.frustum_corners[c]);
-  k[VOL_F_NEAR] = camera.near_plane();
-  k[VOL_F_FAR] = camera.far_plane();
-  k[VOL_F_INV_NEAR] = 1.0f / k[VOL_F_NEAR];
-  k[VOL_F_INV_FAR] = 1.0f / k[VOL_F_FAR];
-  k[VOL_F_ZX] = camera.zbuffer_params.x;
-  k[VOL_F_ZY] = camera.zbuffer_params.y;
+  pack_depth_constants(k, camera);
   k[VOL_F_CORNER_Z] = camera.frustum_corners[kBottomLeft].z;
   put3(VOL_F_LIGHT_DIR, light_dir);
   put3(VOL_F_LIGHT_COLOR, scene.light.color);

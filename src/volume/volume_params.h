@@ -46,6 +46,10 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
                                     const ShadowMapParams* shadow, int shadow_width, int shadow_height,
                                     float max_eye_depth);
 
+// The camera's depth constants into a per-frame array (VOL_F_COUNT floats): VOL_F_NEAR, VOL_F_FAR,
+// their reciprocals VOL_F_INV_NEAR, VOL_F_INV_FAR, and _ZBufferParams.xy (VOL_F_ZX, VOL_F_ZY).
+void pack_depth_constants(float* frame, const CameraParams& camera);
+
 // VOL_STYLIZED, VOL_PHYSICAL or VOL_RIEMANN (kernels/volume_common.h): the march's integrator switch.
 int integrator_code(VolumeIntegrator integrator);
 

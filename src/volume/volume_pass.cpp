@@ -81,9 +81,7 @@ VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<
   if (programs->context() != context)
     throw Error("VolumePass: the shared ProgramCache belongs to another OpenCL context than the pass");
   m.programs = std::move(programs);
-  m.traits.cpu = device_is_cpu(device);
-  m.traits.opencl_c_version = device_opencl_c_version(device);
-  m.traits.cache_bytes = device_cache_bytes(device);
+  m.traits = device_traits(device);
   m.images = with_cl_errors([&] { return m.device.getInfo<CL_DEVICE_IMAGE_SUPPORT>() == CL_TRUE; });
 }
 

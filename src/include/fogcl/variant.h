@@ -8,6 +8,7 @@
 #include "fogcl/camera.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
+#include "fogcl/opencl_types.h"
 
 namespace fogcl {
 
@@ -67,6 +68,9 @@ struct DeviceTraits {
   unsigned long long cache_bytes = 0;             // CL_DEVICE_GLOBAL_MEM_CACHE_SIZE (0: unknown)
   CpuCodegen codegen;                             // read on CPU devices only
 };
+
+// The traits of an OpenCL device, read from it (type, OpenCL C version, cache size), with `codegen`.
+DeviceTraits device_traits(cl_device_id device, const CpuCodegen& codegen = {});
 
 // The smallest frame [pixels] whose RGBA32F output a CPU kernel writes with non-temporal stores
 // (CpuCodegen::streaming_stores); 0 = every frame; -1 = none.
