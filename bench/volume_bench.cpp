@@ -323,8 +323,8 @@ void BM_VolumeCompositeKernel(benchmark::State& state) {
   int arg = 0;
   for (const cl::Buffer* b : {&in, &d, &out, &k, &low, &key}) kernel.setArg(arg++, *b);
   const cl::CommandQueue queue(ctx, device, CL_QUEUE_PROFILING_ENABLE);
-  const int lanes = pixels_per_work_item(traits);
-  const cl::NDRange global((f.color.width() + lanes - 1) / lanes, f.color.height());
+  const auto size = detail::volume_composite_global(packed.variant, traits, f.color.width(), f.color.height());
+  const cl::NDRange global(size[0], size[1]);
   // A copy of the frame's bytes after each dispatch, so that the two medians share the machine's
   // minutes (a copy measured after the loop moved by +-40 % against the composite's minutes).
   FrameCopy copy(input, f.depth);

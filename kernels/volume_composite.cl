@@ -12,7 +12,9 @@
  *   FOG_PORTABLE     CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
  *   FOG_STREAMING_MIN_PIXELS  CPU devices, RGBA32F: frames of at least this many pixels are
  *                    written with non-temporal stores (0: every frame; absent: none)
- * Global size: (ceil(width / VOL_LANES), height).
+ * Global size: volume_composite_global() (src/volume/volume_params.h): (ceil(width / VOL_LANES), height),
+ * or on CPU devices with VOL_SCALE > 1 (ceil(width / 16), the target row pairs: one work-item
+ * takes the VOL_SCALE frame rows between two target rows, volume_composite_cpu.h).
  */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -84,21 +86,34 @@ static inline void vol_composite_pixel(global const COLOR_T* color_in, global co
 
 kernel void volume_composite(global const COLOR_T* color_in, global const float* depth, global COLOR_T* color_out,
                              global const float* frame, global const float* low, global const float* low_key) {
-  const int width = (int)frame[VOL_F_WIDTH];
-  const int y = get_global_id(1);
-  if (y >= (int)frame[VOL_F_HEIGHT]) return;
-  const size_t row = (size_t)y * (size_t)width;
+  const int width = (int)frame[VOL_F_WIDTH], height = (int)frame[VOL_F_HEIGHT];
 #if VOL_LANES == 16
   const int x0 = get_global_id(0) * 16;
-  const int stream = FOG_STREAMS(width, (int)frame[VOL_F_HEIGHT]);
+  const int stream = FOG_STREAMS(width, height);
+#if VOL_SCALE == 1
+  const int y = get_global_id(1);
+  if (y >= height) return;
+  const size_t row = (size_t)y * (size_t)width;
   if (x0 + 16 <= width) {
-    vol_composite16(color_in, depth, color_out, frame, low, low_key, row + x0, x0, y, stream);
+    vol_composite16(color_in, color_out, low, row + x0, stream);
   } else {
     for (int x = x0; x < width; ++x) vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, row + x, x, y);
   }
+#else
+  const int m = get_global_id(1); /* the target row pair: frame rows vol_rows_of(m) */
+  if (x0 + 16 <= width) {
+    vol_composite16(color_in, depth, color_out, frame, low, low_key, x0, m, width, height, stream);
+  } else {
+    int first, last;
+    vol_rows_of(m, height, &first, &last);
+    for (int y = first; y < last; ++y)
+      for (int x = x0; x < width; ++x)
+        vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, (size_t)y * (size_t)width + x, x, y);
+  }
+#endif
 #elif VOL_LANES == 1
-  const int x = get_global_id(0);
-  if (x < width) vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, row + x, x, y);
+  const int x = get_global_id(0), y = get_global_id(1);
+  if (x < width && y < height) vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, (size_t)y * (size_t)width + x, x, y);
 #else
 #error "VOL_LANES must be 1 or 16"
 #endif

@@ -14,7 +14,12 @@
  * compute it with vol_upsample's operations, which are exact here, so every lane rounds like the
  * one-pixel kernel and the C++ path (tests/volume_composite_test.cpp compares the bits). Quad q
  * of the block needs the 4 target columns from b + 4q / s on: one float16 load per target row.
- * Rows whose window reaches past the target's edges load it column by column, clamped. */
+ * Rows whose window reaches past the target's edges load it column by column, clamped.
+ *
+ * Rows. At s > 1 a work-item takes the s frame rows between two target rows (vol_rows_of): their
+ * pixels sample the same two target rows, so the windows, the keys and the test for fog are
+ * loaded and made once for s rows, and with the row's fraction (r + 1/2) / s a constant, the
+ * unrolled rows are independent straight code (docs/volumetric.md, "Lanes on CPU devices"). */
 
 #ifdef __clang__
 /* 16 words (halfwords) at 4-byte (2-byte) alignment, moved by one unaligned vector instruction (as
@@ -154,14 +159,13 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
 #endif
 }
 
-/* 16 pixels of row y from column x0 (a multiple of 16, x0 + 16 <= width), frame index i0. */
-static inline void vol_composite16(global const COLOR_T* color_in, global const float* depth,
-                                   global COLOR_T* color_out, global const float* frame, global const float* low,
-                                   global const float* low_key, size_t i0, int x0, int y, int stream) {
+#if VOL_SCALE == 1
+/* 16 pixels of row y from column x0 (a multiple of 16, x0 + 16 <= width), frame index i0: the
+ * target is the frame's own resolution, each pixel's own sample, unchanged. */
+static inline void vol_composite16(global const COLOR_T* color_in, global COLOR_T* color_out, global const float* low,
+                                   size_t i0, int stream) {
   global const COLOR_T* in = color_in + 4 * i0;
   global COLOR_T* out = color_out + 4 * i0;
-#if VOL_SCALE == 1
-  /* The target is the frame's own resolution: each pixel's own sample, unchanged. */
   const float16 f0 = vload16(0, low + 4 * i0), f1 = vload16(1, low + 4 * i0), f2 = vload16(2, low + 4 * i0),
                 f3 = vload16(3, low + 4 * i0);
   if (vol_fogless(f0, f1, f2, f3)) {
@@ -172,15 +176,28 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   vol_composite_quad(in, out, 1, f1, stream);
   vol_composite_quad(in, out, 2, f2, stream);
   vol_composite_quad(in, out, 3, f3, stream);
+}
 #else
-  const int low_width = (int)frame[VOL_F_LOW_WIDTH];
-  int y0, y1;
-  const float fy = vol_upsample_axis(y, VOL_SCALE, (int)frame[VOL_F_LOW_HEIGHT], &y0, &y1);
-  const float16 gx = (VOL_LANE_INDEX + 0.5f) / (float)VOL_SCALE - 0.5f;
-  const float16 fx = gx - floor(gx);
+/* The frame rows between target rows m - 1 and m: rows s m - s / 2 .. s m + s / 2 - 1, those
+ * inside the frame, in [*first, *last). Their pixels sample target rows m - 1 and m (edges
+ * clamp: vol_upsample_axis), so one work-item loads the target's windows and keys, and tests for
+ * fog, once for s rows. */
+static inline void vol_rows_of(int m, int height, int* first, int* last) {
+  *first = max(VOL_SCALE * m - VOL_SCALE / 2, 0);
+  *last = min(VOL_SCALE * m + VOL_SCALE / 2, height);
+}
+
+/* 16 pixels from column x0 (a multiple of 16, x0 + 16 <= width) of each frame row of target row
+ * pair m (vol_rows_of). */
+static inline void vol_composite16(global const COLOR_T* color_in, global const float* depth,
+                                   global COLOR_T* color_out, global const float* frame, global const float* low,
+                                   global const float* low_key, int x0, int m, int width, int height, int stream) {
+  int first, last;
+  vol_rows_of(m, height, &first, &last);
+  const int low_width = (int)frame[VOL_F_LOW_WIDTH], low_height = (int)frame[VOL_F_LOW_HEIGHT];
   const int b = x0 / VOL_SCALE - 1;
   const int inside = b >= 0 && b + 15 < low_width; /* the keys' load reaches b + 15 */
-  const size_t top = (size_t)y0 * (size_t)low_width, bottom = (size_t)y1 * (size_t)low_width;
+  const size_t top = (size_t)max(m - 1, 0) * (size_t)low_width, bottom = (size_t)min(m, low_height - 1) * (size_t)low_width;
   /* The target's windows of the 4 quads (quad q from column b + 4q / s), in the top and bottom rows. */
 #define VOL_WINDOW(row, q) vol_window_rgba(low, (row), b + 4 * (q) / VOL_SCALE, low_width, inside)
   const float16 t0 = VOL_WINDOW(top, 0), t1 = VOL_WINDOW(top, 1), t2 = VOL_WINDOW(top, 2), t3 = VOL_WINDOW(top, 3);
@@ -189,32 +206,48 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
 #undef VOL_WINDOW
   /* Blocks away from the volumes (most of a frame, usually) are a copy: no depth, no weights. */
   if (vol_fogless(t0, t1, t2, t3) && vol_fogless(u0, u1, u2, u3)) {
-    for (uint q = 0; q < 4; ++q) vol_copy_quad(in, out, q, stream);
+    for (int y = first; y < last; ++y) {
+      const size_t i0 = (size_t)y * (size_t)width + (size_t)x0;
+      for (uint q = 0; q < 4; ++q) vol_copy_quad(color_in + 4 * i0, color_out + 4 * i0, q, stream);
+    }
     return;
   }
-  float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
+  const float16 gx = (VOL_LANE_INDEX + 0.5f) / (float)VOL_SCALE - 0.5f;
+  const float16 fx = gx - floor(gx);
 #if VOL_DEPTH_AWARE
-  /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), and one
-   * reciprocal of their sum per pixel. */
-  const float16 rho = vol_inverse_eye_depth_v(vload16(0, depth + i0), frame);
   const float16 top_keys = vol_capped_keys_v(vol_window_keys(low_key, top, b, low_width, inside));
   const float16 bottom_keys = vol_capped_keys_v(vol_window_keys(low_key, bottom, b, low_width, inside));
+#endif
+  /* Row r of the s: vol_upsample_axis' fraction is (r + 1/2) / s, a constant, clamps or not. */
+#pragma unroll
+  for (int r = 0; r < VOL_SCALE; ++r) {
+    const int y = VOL_SCALE * m - VOL_SCALE / 2 + r;
+    if (y < first || y >= last) continue;
+    const size_t i0 = (size_t)y * (size_t)width + (size_t)x0;
+    global const COLOR_T* in = color_in + 4 * i0;
+    global COLOR_T* out = color_out + 4 * i0;
+    const float fy = ((float)r + 0.5f) / (float)VOL_SCALE;
+    float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
+#if VOL_DEPTH_AWARE
+    /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), and one
+     * reciprocal of their sum per pixel. */
+    const float16 rho = vol_inverse_eye_depth_v(vload16(0, depth + i0), frame);
 #define VOL_E(keys, tap) (VOL_UPSAMPLE_EPS + vol_depth_difference_v(rho, VOL_SHUFFLE(keys, tap)))
-  const float16 e0 = VOL_E(top_keys, VOL_LEFT_TAP), e1 = VOL_E(top_keys, VOL_RIGHT_TAP),
-                e2 = VOL_E(bottom_keys, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, VOL_RIGHT_TAP);
+    const float16 e0 = VOL_E(top_keys, VOL_LEFT_TAP), e1 = VOL_E(top_keys, VOL_RIGHT_TAP),
+                  e2 = VOL_E(bottom_keys, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, VOL_RIGHT_TAP);
 #undef VOL_E
-  const float16 e01 = e0 * e1, e23 = e2 * e3;
-  w0 = w0 * (e1 * e23);
-  w1 = w1 * (e0 * e23);
-  w2 = w2 * (e3 * e01);
-  w3 = w3 * (e2 * e01);
-  const float16 norm = 1.0f / ((w0 + w1) + (w2 + w3));
+    const float16 e01 = e0 * e1, e23 = e2 * e3;
+    w0 = w0 * (e1 * e23);
+    w1 = w1 * (e0 * e23);
+    w2 = w2 * (e3 * e01);
+    w3 = w3 * (e2 * e01);
+    const float16 norm = 1.0f / ((w0 + w1) + (w2 + w3));
 #define VOL_NORMALISE(sum, q) ((sum) * VOL_QUAD_SPREAD(norm, q))
 #else
 #define VOL_NORMALISE(sum, q) (sum) /* the bilinear weights sum to exactly 1 */
 #endif
-  /* vol_upsample's sum: the top row's taps, the bottom row's, their sum, normalised (the
-   * normalisation last, so the division's latency overlaps the taps' arithmetic). */
+    /* vol_upsample's sum: the top row's taps, the bottom row's, their sum, normalised (the
+     * normalisation last, so the division's latency overlaps the taps' arithmetic). */
 #define VOL_QUAD(q, t, u)                                                                     \
   {                                                                                           \
     const float16 top_taps = fma(VOL_SHUFFLE(t, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w1, q),      \
@@ -223,14 +256,15 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
                                     VOL_SHUFFLE(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q));   \
     vol_composite_quad(in, out, q, VOL_NORMALISE(top_taps + bottom_taps, q), stream);         \
   }
-  VOL_QUAD(0, t0, u0)
-  VOL_QUAD(1, t1, u1)
-  VOL_QUAD(2, t2, u2)
-  VOL_QUAD(3, t3, u3)
+    VOL_QUAD(0, t0, u0)
+    VOL_QUAD(1, t1, u1)
+    VOL_QUAD(2, t2, u2)
+    VOL_QUAD(3, t3, u3)
 #undef VOL_QUAD
 #undef VOL_NORMALISE
-#endif
+  }
 }
+#endif
 
 #undef VOL_LANE_INDEX
 #undef VOL_STORE_QUAD

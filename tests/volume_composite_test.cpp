@@ -33,6 +33,7 @@ struct CompositeCase {
   ColorFormat storage;
   View view;
   int width;
+  int height = 0;  // 0: 8 s + 5 (odd: the last target row is a bottom tap, not clamped)
 };
 
 std::string name_of(const testing::TestParamInfo<CompositeCase>& info) {
@@ -40,7 +41,8 @@ std::string name_of(const testing::TestParamInfo<CompositeCase>& info) {
   const char* paths[] = {"lanes", "lanes_portable", "one_pixel"};
   const char* views[] = {"conventional", "reversed", "infinite_far", "orthographic"};
   return std::string(paths[int(c.path)]) + "_s" + std::to_string(c.scale) + (c.depth_aware ? "_aware" : "_bilinear") +
-         (c.storage == ColorFormat::rgba16f ? "_f16_" : "_f32_") + views[int(c.view)] + "_w" + std::to_string(c.width);
+         (c.storage == ColorFormat::rgba16f ? "_f16_" : "_f32_") + views[int(c.view)] + "_w" + std::to_string(c.width) +
+         (c.height ? "_h" + std::to_string(c.height) : "");
 }
 
 std::vector<CompositeCase> all_cases() {
@@ -53,6 +55,11 @@ std::vector<CompositeCase> all_cases() {
     for (Path p : {Path::lanes, Path::one_pixel}) cases.push_back({p, 2, true, ColorFormat::rgba32f, v, 83});
   for (int s : {2, 4}) cases.push_back({Path::lanes, s, true, ColorFormat::rgba16f, View::conventional, 64});
   cases.push_back({Path::lanes, 4, true, ColorFormat::rgba32f, View::conventional, 7});  // a tail only
+  // Heights whose last work-item's rows clamp their bottom tap to the target's last row (the lanes
+  // take the s rows between two target rows per work-item).
+  for (int s : {2, 4})
+    for (ColorFormat f : {ColorFormat::rgba32f, ColorFormat::rgba16f})
+      cases.push_back({Path::lanes, s, true, f, View::conventional, 83, 8 * s + 4});
   return cases;
 }
 
@@ -81,7 +88,7 @@ class VolumeCompositeKernel : public testing::TestWithParam<CompositeCase> {
 TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   using namespace volume_formulas;
   const CompositeCase& c = GetParam();
-  const int width = c.width, height = 8 * c.scale + 5, s = c.scale;
+  const int width = c.width, height = c.height ? c.height : 8 * c.scale + 5, s = c.scale;
   const int low_width = (width + s - 1) / s, low_height = (height + s - 1) / s;
   const CameraParams cam = camera_of(c.view, width, height);
   const bool reversed = cam.reversed_z;
@@ -175,9 +182,8 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   int arg = 0;
   for (const cl::Buffer* b : {&in, &d, &out, &f, &l, &k}) kernel.setArg(arg++, *b);
   const cl::CommandQueue queue(ctx, device);
-  const int lanes = pixels_per_work_item(traits);
-  ASSERT_EQ(queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange((width + lanes - 1) / lanes, height)),
-            CL_SUCCESS);
+  const auto global = detail::volume_composite_global(variant, traits, width, height);
+  ASSERT_EQ(queue.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global[0], global[1])), CL_SUCCESS);
   ColorImage got(width, height, c.storage);
   queue.enqueueReadBuffer(out, CL_TRUE, 0, got.size_bytes(), got.data());
 

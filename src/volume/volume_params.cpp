@@ -369,6 +369,15 @@ std::string volume_composite_options(const VolumeVariant& v, const DeviceTraits&
   return o;
 }
 
+std::array<std::size_t, 2> volume_composite_global(const VolumeVariant& v, const DeviceTraits& device, int width,
+                                                   int height) {
+  const int lanes = pixels_per_work_item(device), s = v.scale;
+  const std::size_t x = std::size_t((width + lanes - 1) / lanes);
+  if (lanes == 1 || s == 1) return {x, std::size_t(height)};
+  // Work-item m takes rows s m - s / 2 .. s m + s / 2 - 1 (vol_rows_of): the last one the row H - 1.
+  return {x, std::size_t((height - 1 + s / 2) / s + 1)};
+}
+
 const NoiseTexture& shared_noise_texture(int size, std::uint32_t seed) {
   static std::mutex mutex;
   static std::map<std::pair<int, std::uint32_t>, std::unique_ptr<NoiseTexture>> cache;

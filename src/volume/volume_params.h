@@ -58,6 +58,11 @@ int integrator_code(VolumeIntegrator integrator);
 int volume_march_lanes(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_march_options(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_composite_options(const VolumeVariant& variant, const DeviceTraits& device);
+// The composite's global size for a width x height frame (kernels/volume_composite.cl): one
+// work-item per frame pixel, or on CPU devices per 16 pixels of a row; there, at scale > 1, of the
+// `scale` rows between two target rows (which share the target's windows).
+std::array<std::size_t, 2> volume_composite_global(const VolumeVariant& variant, const DeviceTraits& device, int width,
+                                                   int height);
 
 // The noise texture of (size, seed), generated once per process and shared (thread-safe).
 const NoiseTexture& shared_noise_texture(int size, std::uint32_t seed);

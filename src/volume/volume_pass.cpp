@@ -228,10 +228,9 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     composite.setArg(4, low);
     composite.setArg(5, low_key);
     const std::vector<cl::Event> after{marched};
-    const std::size_t composite_lanes = std::size_t(pixels_per_work_item(m.traits));  // frame pixels per work-item
-    queue.enqueueNDRangeKernel(composite, cl::NullRange,
-                               cl::NDRange((fb.width + composite_lanes - 1) / composite_lanes, fb.height),
-                               cl::NullRange, &after, &done);
+    const auto global = detail::volume_composite_global(f.variant, m.traits, fb.width, fb.height);
+    queue.enqueueNDRangeKernel(composite, cl::NullRange, cl::NDRange(global[0], global[1]), cl::NullRange, &after,
+                               &done);
     ++m.stats.composite_dispatches;
     return share(done);
   });
