@@ -304,13 +304,17 @@ void BM_VolumeCompositeKernel(benchmark::State& state) {
   const cl::Device device = wrap(runtime().device());
   const cl::Context ctx = wrap(runtime().context());
   const DeviceTraits traits = device_traits(device());
-  const std::string options = detail::volume_composite_options(packed.variant, traits);
-  cl::Program program(ctx, std::string(volume_composite_cl));
-  if (program.build({device}, options.c_str()) != CL_SUCCESS) {
-    state.SkipWithError(program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device).c_str());
+  // Built as the pass builds it (ProgramCache: CL error names and the build log on failure).
+  ProgramCache programs(ctx());
+  cl::Kernel kernel;
+  try {
+    const cl_program program = programs.get(device(), "volume_composite.cl", volume_composite_cl,
+                                            detail::volume_composite_options(packed.variant, traits));
+    kernel = cl::Kernel(cl::Program(program, true), "volume_composite");
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
     return;
   }
-  cl::Kernel kernel(program, "volume_composite");
   const ColorImage input = convert(f.color, storage);
   const auto buffer = [&](const void* p, std::size_t bytes) {
     return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(p));
