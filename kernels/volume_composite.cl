@@ -84,8 +84,10 @@ static inline void vol_composite_pixel(global const COLOR_T* color_in, global co
 #include "volume_composite_cpu.h"
 #endif
 
-kernel void volume_composite(global const COLOR_T* color_in, global const float* depth, global COLOR_T* color_out,
-                             global const float* frame, global const float* low, global const float* low_key) {
+/* restrict on the read-only inputs lets LLVM hoist frame[] loads past the color stores; not on
+ * the colors, which may be one buffer (in place). */
+kernel void volume_composite(global const COLOR_T* color_in, global const float* restrict depth, global COLOR_T* color_out,
+                             global const float* restrict frame, global const float* restrict low, global const float* restrict low_key) {
   const int width = (int)frame[VOL_F_WIDTH], height = (int)frame[VOL_F_HEIGHT];
 #if VOL_LANES == 16
   const int x0 = get_global_id(0) * 16;

@@ -10,16 +10,18 @@
  * colors and the target's (P, A) as quads, 4 pixels x RGBA per float16, as in fog_cpu_blocks.h.
  * With x0 a multiple of 16 and s in {2, 4}, pixel j of the block samples the target columns
  * b + L_j and b + L_j + 1, b = x0 / s - 1, L_j = (j + s / 2) / s (vol_upsample_axis' floor of
- * (x + 0.5) / s - 0.5, clamps aside), and its bilinear fraction depends only on j % s: the lanes
- * compute it with vol_upsample's operations, which are exact here, so every lane rounds like the
- * one-pixel kernel and the C++ path (tests/volume_composite_test.cpp compares the bits). Quad q
- * of the block needs the 4 target columns from b + 4q / s on: one float16 load per target row.
- * Rows whose window reaches past the target's edges load it column by column, clamped.
+ * (x + 0.5) / s - 0.5, clamps aside), and its bilinear fraction depends only on j % s (VOL_FX,
+ * exact): every lane rounds like the one-pixel kernel and the C++ path
+ * (tests/volume_composite_test.cpp compares the bits). Quad q of the block needs the 4 target
+ * columns from b + 4q / s on: one float16 load per target row. Rows whose window reaches past the
+ * target's edges load it column by column, clamped. Per-pixel float16s are kept in
+ * VOL_PIXEL_ORDER (below), not the row's order.
  *
  * Rows. At s > 1 a work-item takes the s frame rows between two target rows (vol_rows_of): their
  * pixels sample the same two target rows, so the windows, the keys and the test for fog are
  * loaded and made once for s rows, and with the row's fraction (r + 1/2) / s a constant, the
- * unrolled rows are independent straight code (docs/volumetric.md, "Lanes on CPU devices"). */
+ * rows are independent straight code: all s rows' weights first, then their quads
+ * (docs/volumetric.md, "Lanes on CPU devices"). */
 
 #ifdef __clang__
 /* 16 words (halfwords) at 4-byte (2-byte) alignment, moved by one unaligned vector instruction (as
@@ -41,25 +43,30 @@ typedef ushort vol_v16h_u __attribute__((__vector_size__(32), aligned(2)));
   FOG_STREAM_OR((bits), (global uint*)(out) + 16 * (q), (stream), VOL_STORE16U((bits), (global uint*)(out) + 16 * (q)))
 #endif
 
-#define VOL_LANE_INDEX (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
 /* Shuffle masks (literal constants: one permute each, FOG_SHUFFLE). L_j, and within a quad's
- * 4-column window the column of each pixel's left tap (its right tap is the next one). */
+ * 4-column window the column of each pixel's left tap (its right tap is the next one). VOL_FX:
+ * pixel j's bilinear fraction, frac((j + 1/2) / s - 1/2), as literals (exact in binary, so they are
+ * vol_upsample_axis' values; PoCL's floor would not fold at build time). */
 #if VOL_SCALE == 2
 #define VOL_LEFT_TAP 0, 1, 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8
 #define VOL_RIGHT_TAP 1, 2, 2, 3, 3, 4, 4, 5, 5, 6, 6, 7, 7, 8, 8, 9
+#define VOL_FX 0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f, 0.75f, 0.25f
 #define VOL_QUAD_LEFT 0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11
 #define VOL_QUAD_RIGHT 4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11, 12, 13, 14, 15
 #elif VOL_SCALE == 4
 #define VOL_LEFT_TAP 0, 0, 1, 1, 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4
 #define VOL_RIGHT_TAP 1, 1, 2, 2, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 5, 5
+#define VOL_FX 0.625f, 0.875f, 0.125f, 0.375f, 0.625f, 0.875f, 0.125f, 0.375f, 0.625f, 0.875f, 0.125f, 0.375f, 0.625f, 0.875f, 0.125f, 0.375f
 #define VOL_QUAD_LEFT 0, 1, 2, 3, 0, 1, 2, 3, 4, 5, 6, 7, 4, 5, 6, 7
 #define VOL_QUAD_RIGHT 4, 5, 6, 7, 4, 5, 6, 7, 8, 9, 10, 11, 8, 9, 10, 11
 #endif
 #define VOL_SHUFFLE(v, ...) FOG_SHUFFLE((v), (v), __VA_ARGS__)
-/* Lanes 4q .. 4q + 3 of a per-pixel float16 (q a literal), each spread over its pixel's RGBA lanes. */
-#define VOL_QUAD_SPREAD(v, q)                                                                       \
-  VOL_SHUFFLE((v), 4 * q, 4 * q, 4 * q, 4 * q, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 1, 4 * q + 2, \
-              4 * q + 2, 4 * q + 2, 4 * q + 2, 4 * q + 3, 4 * q + 3, 4 * q + 3, 4 * q + 3)
+/* Per-pixel float16s hold pixel 4q + k in lane 4k + q (VOL_PIXEL_ORDER of a row's natural order),
+ * so that VOL_QUAD_SPREAD, quad q's 4 pixels each spread over its RGBA lanes (q a literal), stays
+ * within 128-bit lanes: one vpermilps, not a cross-lane vpermps (-12 % for depth-aware RGBA16F). */
+#define VOL_PIXEL_ORDER(v) VOL_SHUFFLE((v), 0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15)
+#define VOL_QUAD_SPREAD(v, q) \
+  VOL_SHUFFLE((v), q, q, q, q, 4 + q, 4 + q, 4 + q, 4 + q, 8 + q, 8 + q, 8 + q, 8 + q, 12 + q, 12 + q, 12 + q, 12 + q)
 #define VOL_QUAD_ALPHA(v) VOL_SHUFFLE((v), 3, 3, 3, 3, 7, 7, 7, 7, 11, 11, 11, 11, 15, 15, 15, 15)
 #define VOL_ALPHA_LANES (int16)(0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1, 0, 0, 0, -1)
 
@@ -212,62 +219,87 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
     }
     return;
   }
-  const float16 gx = (VOL_LANE_INDEX + 0.5f) / (float)VOL_SCALE - 0.5f;
-  const float16 fx = gx - floor(gx);
+  const float16 fx = VOL_PIXEL_ORDER((float16)(VOL_FX));
 #if VOL_DEPTH_AWARE
   const float16 top_keys = vol_capped_keys_v(vol_window_keys(low_key, top, b, low_width, inside));
   const float16 bottom_keys = vol_capped_keys_v(vol_window_keys(low_key, bottom, b, low_width, inside));
 #endif
-  /* Row r of the s: vol_upsample_axis' fraction is (r + 1/2) / s, a constant, clamps or not. */
+  /* Row r of the s (r a literal or the loop's index, named by the token n): its frame index i0_n and
+   * vol_upsample's weights w0_n .. w3_n (and norm_n, the reciprocal of their sum), with
+   * vol_upsample_axis' fraction (r + 1/2) / s, a constant, clamps or not. */
+#if VOL_DEPTH_AWARE
+#define VOL_E(keys, tap) (VOL_UPSAMPLE_EPS + vol_depth_difference_v(rho, VOL_PIXEL_ORDER(VOL_SHUFFLE(keys, tap))))
+#define VOL_ROW_WEIGHTS(n, r)                                                                         \
+  const size_t i0_##n = (size_t)(VOL_SCALE * m - VOL_SCALE / 2 + (r)) * (size_t)width + (size_t)x0;   \
+  float16 w0_##n, w1_##n, w2_##n, w3_##n, norm_##n;                                                  \
+  {                                                                                                   \
+    const float fy = ((float)(r) + 0.5f) / (float)VOL_SCALE;                                          \
+    /* bilinear x the other taps' (EPS + depth difference), one reciprocal of their sum per pixel */  \
+    const float16 rho = vol_inverse_eye_depth_v(VOL_PIXEL_ORDER(vload16(0, depth + i0_##n)), frame);  \
+    const float16 e0 = VOL_E(top_keys, VOL_LEFT_TAP), e1 = VOL_E(top_keys, VOL_RIGHT_TAP);            \
+    const float16 e2 = VOL_E(bottom_keys, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, VOL_RIGHT_TAP);      \
+    const float16 e01 = e0 * e1, e23 = e2 * e3;                                                       \
+    w0_##n = ((1.0f - fx) * (1.0f - fy)) * (e1 * e23);                                                \
+    w1_##n = (fx * (1.0f - fy)) * (e0 * e23);                                                         \
+    w2_##n = ((1.0f - fx) * fy) * (e3 * e01);                                                         \
+    w3_##n = (fx * fy) * (e2 * e01);                                                                  \
+    norm_##n = 1.0f / ((w0_##n + w1_##n) + (w2_##n + w3_##n));                                        \
+  }
+#define VOL_NORMALISE(sum, q, n) ((sum) * VOL_QUAD_SPREAD(norm_##n, q))
+#else
+#define VOL_ROW_WEIGHTS(n, r)                                                                         \
+  const size_t i0_##n = (size_t)(VOL_SCALE * m - VOL_SCALE / 2 + (r)) * (size_t)width + (size_t)x0;   \
+  const float fy_##n = ((float)(r) + 0.5f) / (float)VOL_SCALE;                                        \
+  const float16 w0_##n = (1.0f - fx) * (1.0f - fy_##n), w1_##n = fx * (1.0f - fy_##n),                \
+                w2_##n = (1.0f - fx) * fy_##n, w3_##n = fx * fy_##n;
+#define VOL_NORMALISE(sum, q, n) (sum) /* the bilinear weights sum to exactly 1 */
+#endif
+  /* vol_upsample's sum for quad q of row n: the top row's taps, the bottom row's, their sum,
+   * normalised (last, so the division's latency overlaps the taps' arithmetic). */
+#define VOL_QUAD(q, t, u, n)                                                                          \
+  {                                                                                                   \
+    const float16 top_taps = fma(VOL_SHUFFLE(t, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w1_##n, q),          \
+                                 VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0_##n, q));          \
+    const float16 bottom_taps = fma(VOL_SHUFFLE(u, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w3_##n, q),       \
+                                    VOL_SHUFFLE(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2_##n, q));       \
+    vol_composite_quad(color_in + 4 * i0_##n, color_out + 4 * i0_##n, q,                              \
+                       VOL_NORMALISE(top_taps + bottom_taps, q, n), stream);                          \
+  }
+#define VOL_ROW_QUADS(n) VOL_QUAD(0, t0, u0, n) VOL_QUAD(1, t1, u1, n) VOL_QUAD(2, t2, u2, n) VOL_QUAD(3, t3, u3, n)
+  /* All s rows in the frame (every pair but the frame's first and last): the rows' weights first,
+   * then their quads, so that each row's chain (depth, weights, division) overlaps the others'. */
+  if (first == VOL_SCALE * m - VOL_SCALE / 2 && last == VOL_SCALE * m + VOL_SCALE / 2) {
+    VOL_ROW_WEIGHTS(0, 0)
+    VOL_ROW_WEIGHTS(1, 1)
+#if VOL_SCALE == 4
+    VOL_ROW_WEIGHTS(2, 2)
+    VOL_ROW_WEIGHTS(3, 3)
+#endif
+    VOL_ROW_QUADS(0)
+    VOL_ROW_QUADS(1)
+#if VOL_SCALE == 4
+    VOL_ROW_QUADS(2)
+    VOL_ROW_QUADS(3)
+#endif
+    return;
+  }
 #pragma unroll
   for (int r = 0; r < VOL_SCALE; ++r) {
     const int y = VOL_SCALE * m - VOL_SCALE / 2 + r;
     if (y < first || y >= last) continue;
-    const size_t i0 = (size_t)y * (size_t)width + (size_t)x0;
-    global const COLOR_T* in = color_in + 4 * i0;
-    global COLOR_T* out = color_out + 4 * i0;
-    const float fy = ((float)r + 0.5f) / (float)VOL_SCALE;
-    float16 w0 = (1.0f - fx) * (1.0f - fy), w1 = fx * (1.0f - fy), w2 = (1.0f - fx) * fy, w3 = fx * fy;
-#if VOL_DEPTH_AWARE
-    /* vol_upsample's weights: bilinear x the other taps' (EPS + depth difference), and one
-     * reciprocal of their sum per pixel. */
-    const float16 rho = vol_inverse_eye_depth_v(vload16(0, depth + i0), frame);
-#define VOL_E(keys, tap) (VOL_UPSAMPLE_EPS + vol_depth_difference_v(rho, VOL_SHUFFLE(keys, tap)))
-    const float16 e0 = VOL_E(top_keys, VOL_LEFT_TAP), e1 = VOL_E(top_keys, VOL_RIGHT_TAP),
-                  e2 = VOL_E(bottom_keys, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, VOL_RIGHT_TAP);
-#undef VOL_E
-    const float16 e01 = e0 * e1, e23 = e2 * e3;
-    w0 = w0 * (e1 * e23);
-    w1 = w1 * (e0 * e23);
-    w2 = w2 * (e3 * e01);
-    w3 = w3 * (e2 * e01);
-    const float16 norm = 1.0f / ((w0 + w1) + (w2 + w3));
-#define VOL_NORMALISE(sum, q) ((sum) * VOL_QUAD_SPREAD(norm, q))
-#else
-#define VOL_NORMALISE(sum, q) (sum) /* the bilinear weights sum to exactly 1 */
-#endif
-    /* vol_upsample's sum: the top row's taps, the bottom row's, their sum, normalised (the
-     * normalisation last, so the division's latency overlaps the taps' arithmetic). */
-#define VOL_QUAD(q, t, u)                                                                     \
-  {                                                                                           \
-    const float16 top_taps = fma(VOL_SHUFFLE(t, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w1, q),      \
-                                 VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0, q));      \
-    const float16 bottom_taps = fma(VOL_SHUFFLE(u, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w3, q),   \
-                                    VOL_SHUFFLE(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2, q));   \
-    vol_composite_quad(in, out, q, VOL_NORMALISE(top_taps + bottom_taps, q), stream);         \
+    VOL_ROW_WEIGHTS(row, r)
+    VOL_ROW_QUADS(row)
   }
-    VOL_QUAD(0, t0, u0)
-    VOL_QUAD(1, t1, u1)
-    VOL_QUAD(2, t2, u2)
-    VOL_QUAD(3, t3, u3)
+#undef VOL_ROW_QUADS
 #undef VOL_QUAD
+#undef VOL_ROW_WEIGHTS
+#undef VOL_E
 #undef VOL_NORMALISE
-  }
 }
 #endif
 
-#undef VOL_LANE_INDEX
 #undef VOL_STORE_QUAD
 #undef VOL_QUAD_SPREAD
+#undef VOL_PIXEL_ORDER
 #undef VOL_QUAD_ALPHA
 #undef VOL_ALPHA_LANES
