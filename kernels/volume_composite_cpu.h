@@ -92,8 +92,20 @@ static inline float16 vol_inverse_eye_depth_v(float16 raw, global const float* f
 /* vol_depth_difference (volume_composite.h) lane-wise, its key already capped (vol_capped_keys_v). */
 static inline float16 vol_capped_keys_v(float16 k) { return select((float16)VOL_KEY_SKY, k, k < VOL_KEY_SKY); }
 static inline float16 vol_depth_difference_v(float16 rho, float16 key) {
-  const float16 d = fabs(fma(-key, rho, (float16)1.0f));
+  const float16 x = fma(-key, rho, (float16)1.0f);
+#if defined(FOG_AVX512) && defined(__AVX512DQ__)
+  /* min(|x|, 1) as one vrangeps (of x and 1 the smaller magnitude, sign cleared), not and + min:
+   * -4..8 % for depth-aware RGBA16F. A NaN x (k rho = 0 inf: a key of 0 and rho = inf, at an
+   * orthographic near plane at 0) is a quiet NaN, and vrangeps gives the other operand for a
+   * quiet NaN and a number (Intel SDM, VRANGEPS, "Signaling of Comparison Operations"): 1, as
+   * the select does. */
+  return __builtin_bit_cast(float16, __builtin_ia32_rangeps512_mask(
+      __builtin_bit_cast(fog_v16f, x), __builtin_bit_cast(fog_v16f, (float16)1.0f), 0x0a /* min |.|, sign 0 */,
+      (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
+#else
+  const float16 d = fabs(x);
   return select((float16)1.0f, d, d < 1.0f);
+#endif
 }
 
 /* A target row's window for a block, as values (no private arrays: PoCL gives those a copy per

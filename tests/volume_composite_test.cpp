@@ -24,7 +24,9 @@ namespace fogcl::test {
 namespace {
 
 enum class Path { lanes, lanes_portable, one_pixel };
-enum class View { conventional, reversed, infinite_far, orthographic };
+// orthographic_near0: the near plane at 0, where a pixel on it has 1 / eye depth = inf and its block
+// a key of 0: the depth difference's 1 - k rho is NaN (the CPU lanes' vrangeps must give 1 for it).
+enum class View { conventional, reversed, infinite_far, orthographic, orthographic_near0 };
 
 struct CompositeCase {
   Path path;
@@ -39,7 +41,7 @@ struct CompositeCase {
 std::string name_of(const testing::TestParamInfo<CompositeCase>& info) {
   const CompositeCase& c = info.param;
   const char* paths[] = {"lanes", "lanes_portable", "one_pixel"};
-  const char* views[] = {"conventional", "reversed", "infinite_far", "orthographic"};
+  const char* views[] = {"conventional", "reversed", "infinite_far", "orthographic", "orthographic_near0"};
   return std::string(paths[int(c.path)]) + "_s" + std::to_string(c.scale) + (c.depth_aware ? "_aware" : "_bilinear") +
          (c.storage == ColorFormat::rgba16f ? "_f16_" : "_f32_") + views[int(c.view)] + "_w" + std::to_string(c.width) +
          (c.height ? "_h" + std::to_string(c.height) : "");
@@ -51,7 +53,7 @@ std::vector<CompositeCase> all_cases() {
     for (int s : {1, 2, 4})
       for (bool aware : {true, false})
         for (ColorFormat f : {ColorFormat::rgba32f, ColorFormat::rgba16f}) cases.push_back({p, s, aware, f, View::conventional, 83});
-  for (View v : {View::reversed, View::infinite_far, View::orthographic})
+  for (View v : {View::reversed, View::infinite_far, View::orthographic, View::orthographic_near0})
     for (Path p : {Path::lanes, Path::one_pixel}) cases.push_back({p, 2, true, ColorFormat::rgba32f, v, 83});
   for (int s : {2, 4}) cases.push_back({Path::lanes, s, true, ColorFormat::rgba16f, View::conventional, 64});
   cases.push_back({Path::lanes, 4, true, ColorFormat::rgba32f, View::conventional, 7});  // a tail only
@@ -64,9 +66,10 @@ std::vector<CompositeCase> all_cases() {
 }
 
 CameraParams camera_of(View view, int width, int height) {
-  if (view == View::orthographic) {
+  if (view == View::orthographic || view == View::orthographic_near0) {
     OrthographicCamera o;
     o.aspect = float(width) / float(height);
+    if (view == View::orthographic_near0) o.near_plane = 0.0f;
     return make_camera_params(o);
   }
   PerspectiveCamera p;
@@ -95,11 +98,12 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   std::mt19937 rng(11 + s);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
 
-  // Depth: random raw values, every 7th pixel sky, every 29th NaN.
+  // Depth: random raw values, every 7th pixel sky, every 29th NaN, every 11th on the near plane.
   DepthImage depth(width, height);
   for (int i = 0; i < width * height; ++i)
     depth.data()[i] = i % 29 == 3 ? std::numeric_limits<float>::quiet_NaN()
                       : i % 7 == 0 ? (reversed ? 0.0f : 1.0f)
+                      : i % 11 == 5 ? (reversed ? 1.0f : 0.0f)
                                    : unit(rng);
   // Color: random HDR, and NaN, Inf and signalling NaNs (alpha too) in a pattern.
   ColorImage color(width, height, c.storage);
