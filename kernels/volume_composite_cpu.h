@@ -145,6 +145,21 @@ static inline int vol_fogless(float16 t0, float16 t1, float16 t2, float16 t3) {
   return !VOL_ANY16(bits != 0u);
 }
 
+/* vol_composite's channel rule on a quad: fma(c, 1 - a, fog), fog where a == 1. With AVX-512 one
+ * fma whose mask keeps fog (vfmadd231ps {k}), not an fma and a blend. */
+static inline float16 vol_over(float16 c, float16 a, float16 fog) {
+#ifdef FOG_AVX512
+  const ushort not_opaque = __builtin_ia32_cmpps512_mask(
+      __builtin_bit_cast(fog_v16f, a), __builtin_bit_cast(fog_v16f, (float16)1.0f), 0x04 /* _CMP_NEQ_UQ */,
+      (ushort)0xffff, 4 /* current rounding */);
+  return __builtin_bit_cast(float16, __builtin_ia32_vfmaddps512_mask3(
+      __builtin_bit_cast(fog_v16f, c), __builtin_bit_cast(fog_v16f, 1.0f - a), __builtin_bit_cast(fog_v16f, fog),
+      not_opaque, 4 /* current rounding */));
+#else
+  return select(fma(c, 1.0f - a, fog), fog, a == 1.0f);
+#endif
+}
+
 /* Quad q of the block as bits: the composite where 0 < A, the input's bits where A == 0 and in
  * the alpha lanes (vol_composite's rules; A == 1 writes P exactly). */
 static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* out, uint q, float16 fog,
@@ -159,7 +174,7 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
 #else
   const float16 c = vload_half16(q, in);
 #endif
-  const float16 o = select(fma(c, 1.0f - a, fog), fog, a == 1.0f);
+  const float16 o = vol_over(c, a, fog);
 #ifdef FOG_AVX512
   const ushort16 rounded = __builtin_bit_cast(ushort16, __builtin_ia32_vcvtps2ph512_mask(
       __builtin_bit_cast(fog_v16f, o), 0 /* round to nearest even */, (fog_v16h){}, (ushort)0xffff));
@@ -172,7 +187,7 @@ static inline void vol_composite_quad(global const COLOR_T* in, global COLOR_T* 
 #else
   const uint16 bits = vload16(q, (global const uint*)in);
   const float16 c = as_float16(bits);
-  const float16 o = select(fma(c, 1.0f - a, fog), fog, a == 1.0f);
+  const float16 o = vol_over(c, a, fog);
   const uint16 result = select(as_uint16(o), bits, keep);
   VOL_STORE_QUAD(result, out, q, stream);
 #endif
