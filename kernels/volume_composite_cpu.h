@@ -252,33 +252,33 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   const float16 bottom_keys = vol_capped_keys_v(vol_window_keys(low_key, bottom, b, low_width, inside));
 #endif
   /* Row r of the s (r a literal or the loop's index, named by the token n): its frame index i0_n and
-   * vol_upsample's weights w0_n .. w3_n (and norm_n, the reciprocal of their sum), with
-   * vol_upsample_axis' fraction (r + 1/2) / s, a constant, clamps or not. */
-#if VOL_DEPTH_AWARE
-#define VOL_E(keys, tap) (VOL_UPSAMPLE_EPS + vol_depth_difference_v(rho, VOL_PIXEL_ORDER(VOL_SHUFFLE(keys, tap))))
+   * vol_upsample's weights w0_n .. w3_n, bilinear with vol_upsample_axis' fraction (r + 1/2) / s (a
+   * constant, clamps or not), depth-aware: times the other taps' (EPS + depth difference), with
+   * norm_n the reciprocal of their sum. */
 #define VOL_ROW_WEIGHTS(n, r)                                                                         \
   const size_t i0_##n = (size_t)(VOL_SCALE * m - VOL_SCALE / 2 + (r)) * (size_t)width + (size_t)x0;   \
-  float16 w0_##n, w1_##n, w2_##n, w3_##n, norm_##n;                                                  \
+  const float fy_##n = ((float)(r) + 0.5f) / (float)VOL_SCALE;                                        \
+  float16 w0_##n = (1.0f - fx) * (1.0f - fy_##n), w1_##n = fx * (1.0f - fy_##n),                      \
+          w2_##n = (1.0f - fx) * fy_##n, w3_##n = fx * fy_##n;                                        \
+  VOL_DEPTH_WEIGHTS(n)
+#if VOL_DEPTH_AWARE
+#define VOL_E(keys, tap) (VOL_UPSAMPLE_EPS + vol_depth_difference_v(rho, VOL_PIXEL_ORDER(VOL_SHUFFLE(keys, tap))))
+#define VOL_DEPTH_WEIGHTS(n)                                                                          \
+  float16 norm_##n;                                                                                   \
   {                                                                                                   \
-    const float fy = ((float)(r) + 0.5f) / (float)VOL_SCALE;                                          \
-    /* bilinear x the other taps' (EPS + depth difference), one reciprocal of their sum per pixel */  \
     const float16 rho = vol_inverse_eye_depth_v(VOL_PIXEL_ORDER(vload16(0, depth + i0_##n)), frame);  \
     const float16 e0 = VOL_E(top_keys, VOL_LEFT_TAP), e1 = VOL_E(top_keys, VOL_RIGHT_TAP);            \
     const float16 e2 = VOL_E(bottom_keys, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, VOL_RIGHT_TAP);      \
     const float16 e01 = e0 * e1, e23 = e2 * e3;                                                       \
-    w0_##n = ((1.0f - fx) * (1.0f - fy)) * (e1 * e23);                                                \
-    w1_##n = (fx * (1.0f - fy)) * (e0 * e23);                                                         \
-    w2_##n = ((1.0f - fx) * fy) * (e3 * e01);                                                         \
-    w3_##n = (fx * fy) * (e2 * e01);                                                                  \
+    w0_##n *= e1 * e23;                                                                               \
+    w1_##n *= e0 * e23;                                                                               \
+    w2_##n *= e3 * e01;                                                                               \
+    w3_##n *= e2 * e01;                                                                               \
     norm_##n = 1.0f / ((w0_##n + w1_##n) + (w2_##n + w3_##n));                                        \
   }
 #define VOL_NORMALISE(sum, q, n) ((sum) * VOL_QUAD_SPREAD(norm_##n, q))
 #else
-#define VOL_ROW_WEIGHTS(n, r)                                                                         \
-  const size_t i0_##n = (size_t)(VOL_SCALE * m - VOL_SCALE / 2 + (r)) * (size_t)width + (size_t)x0;   \
-  const float fy_##n = ((float)(r) + 0.5f) / (float)VOL_SCALE;                                        \
-  const float16 w0_##n = (1.0f - fx) * (1.0f - fy_##n), w1_##n = fx * (1.0f - fy_##n),                \
-                w2_##n = (1.0f - fx) * fy_##n, w3_##n = fx * fy_##n;
+#define VOL_DEPTH_WEIGHTS(n)
 #define VOL_NORMALISE(sum, q, n) (sum) /* the bilinear weights sum to exactly 1 */
 #endif
   /* vol_upsample's sum for quad q of row n: the top row's taps, the bottom row's, their sum,
@@ -320,6 +320,7 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
 #undef VOL_ROW_QUADS
 #undef VOL_QUAD
 #undef VOL_ROW_WEIGHTS
+#undef VOL_DEPTH_WEIGHTS
 #undef VOL_E
 #undef VOL_NORMALISE
 }
