@@ -92,6 +92,55 @@ TEST(DepthKinds, DistanceIsDividedByThePixelsRayLength) {
   EXPECT_EQ(raw.at(5, 5), distance.at(5, 5));
 }
 
+// The other projections: orthographic (Linear01Depth = x raw + y, eye = Linear01Depth far) in both Z
+// directions and the infinite far plane (eye = near / raw) round-trip through their own formulas;
+// distance on the infinite far plane divides by the ray normalised to view z = 1; distance with an
+// orthographic camera (parallel rays) is refused.
+TEST(DepthKinds, OrthographicAndInfiniteFarRoundTrip) {
+  for (bool reversed : {false, true}) {
+    OrthographicCamera o;
+    o.near_plane = 0.3f;
+    o.far_plane = 1000.0f;
+    o.reversed_z = reversed;
+    const CameraParams p = make_camera_params(o);
+    double worst = 0;
+    for (double eye = 0.31; eye < 999.0; eye *= 1.07) {
+      const double raw = float(raw_from_eye_depth(eye, p));
+      const double back = (double(p.zbuffer_params.x) * raw + double(p.zbuffer_params.y)) * double(p.far_plane());
+      worst = std::max(worst, std::fabs(back - eye) / eye);
+    }
+    std::printf("[ worst    ] orthographic eye -> raw -> eye (%s Z): rel %.2e\n", reversed ? "reversed" : "conventional",
+                worst);
+    EXPECT_LE(worst, 2e-4);  // float raw resolves far * 2^-24 in eye depth: 6e-5 of 0.31 + rounding
+    EXPECT_EQ(raw_from_eye_depth(2000.0, p), double(sky_raw_depth(p)));
+    DepthImage d(4, 3, 5.0f);
+    EXPECT_THROW(to_raw_depth(d, DepthKind::distance, p), Error);
+    EXPECT_EQ(d.at(1, 1), 5.0f);  // refused before any pixel changed
+  }
+  PerspectiveCamera c = camera(true);
+  c.infinite_far = true;
+  const CameraParams p = make_camera_params(c);
+  double worst = 0;
+  for (double eye = 0.31; eye < 1e7; eye *= 1.07) {
+    const double raw = float(raw_from_eye_depth(eye, p));
+    worst = std::max(worst, std::fabs(double(p.near_plane()) / raw - eye) / eye);
+  }
+  std::printf("[ worst    ] infinite far eye -> raw -> eye: rel %.2e\n", worst);
+  EXPECT_LE(worst, 1e-7);
+  EXPECT_EQ(raw_from_eye_depth(std::numeric_limits<double>::infinity(), p), 0.0);
+  const int w = 9, h = 5;
+  DepthImage d(w, h, 42.0f);
+  to_raw_depth(d, DepthKind::distance, p);
+  const double tan_v = std::tan(double(c.fov_y_deg) * 3.14159265358979323846 / 360.0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double u = (x + 0.5) / w, v = 1.0 - (y + 0.5) / h;
+      const double rx = (2 * u - 1) * tan_v * double(c.aspect), ry = (2 * v - 1) * tan_v;
+      const double eye = double(p.near_plane()) / double(d.at(x, y));
+      EXPECT_NEAR(eye * std::sqrt(rx * rx + ry * ry + 1.0), 42.0, 42.0 * 1e-6) << x << ", " << y;
+    }
+}
+
 TEST(DepthKinds, ParseNamesTheBadValue) {
   EXPECT_EQ(parse_depth_kind("eye"), DepthKind::eye);
   EXPECT_EQ(parse_depth_kind("distance"), DepthKind::distance);

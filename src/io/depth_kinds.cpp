@@ -28,17 +28,27 @@ DepthKind parse_depth_kind(const std::string& text) {
 float sky_raw_depth(const CameraParams& camera) { return camera.reversed_z ? 0.0f : 1.0f; }
 
 double raw_from_eye_depth(double eye, const CameraParams& camera) {
-  const double far_plane = double(camera.far_plane());
+  const double far_plane = double(camera.far_plane()), x = double(camera.zbuffer_params.x),
+               y = double(camera.zbuffer_params.y);
   if (!std::isfinite(eye) || eye <= 0.0 || eye >= far_plane) return double(sky_raw_depth(camera));
-  const double raw = (far_plane / eye - double(camera.zbuffer_params.y)) / double(camera.zbuffer_params.x);
+  double raw = 0.0;
+  switch (camera.projection) {
+    case Projection::perspective: raw = (far_plane / eye - y) / x; break;
+    case Projection::perspective_infinite_far: raw = double(camera.near_plane()) / eye; break;
+    case Projection::orthographic: raw = (eye / far_plane - y) / x; break;
+  }
   return std::fmin(std::fmax(raw, 0.0), 1.0);  // nearer than the near plane: the near plane
 }
 
 void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera) {
   if (kind == DepthKind::raw) return;
   validate(camera);
+  if (kind == DepthKind::distance && camera.projection == Projection::orthographic)
+    throw Error("depth kind distance needs a perspective camera (an orthographic camera's rays are parallel: give "
+                "eye or raw depth)");
+  // The far-plane rays' view z: far, or 1 with an infinite far plane (their corners are normalised).
+  const double ray_z = camera.projection == Projection::perspective_infinite_far ? 1.0 : double(camera.far_plane());
   const int w = depth.width(), h = depth.height();
-  const double far_plane = double(camera.far_plane());
   const auto& c = camera.frustum_corners;
   const double inv_width = 1.0 / double(w);
   for (int y = 0; y < h; ++y) {
@@ -49,7 +59,7 @@ void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera)
       if (kind == DepthKind::distance) {
         const double length =
             depth_math::fog_corner_ray_term(c, depth_math::fog_pixel_u<double>(x, inv_width), v, /*squared=*/0);
-        eye = eye * far_plane / length;  // non-finite / <= 0 stay so, and become sky below
+        eye = eye * ray_z / length;  // non-finite / <= 0 stay so, and become sky below
       }
       d = float(raw_from_eye_depth(eye, camera));
     }
