@@ -2,9 +2,11 @@
  * (docs/volumetric.md §Resolution, upsampling, composite). Needs volume_common.h and the
  * one-pixel instance of fog_math.h (the depth formulas). */
 
-/* Weight floor of the depth-aware upsampling: a tap's weight is its bilinear weight over
- * (VOL_UPSAMPLE_EPS + depth difference), so taps on the pixel's own surface win about 50 : 1 over
- * taps across a silhouette, and taps on one surface keep plain bilinear weights. */
+/* Depth tolerance of the depth-aware upsampling: a tap whose depth difference (below) is at most
+ * this is on the pixel's own surface. A tap's weight is its bilinear weight over max(difference,
+ * VOL_UPSAMPLE_EPS), so taps on the pixel's surface win 100 : 1 over taps across a silhouette
+ * (difference 1, the cap), and a pixel whose four taps are all on its surface takes the bilinear
+ * weights exactly (vol_upsample; docs/volumetric.md §Resolution, upsampling, composite). */
 #define VOL_UPSAMPLE_EPS 0.01f
 
 /* The depth difference of a frame pixel (eye depth e) and a tap (the target's key k, the eye depth
@@ -81,20 +83,29 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL
   const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
   VOL_REAL w[4] = {((VOL_REAL)1 - fx) * ((VOL_REAL)1 - fy), fx * ((VOL_REAL)1 - fy), ((VOL_REAL)1 - fx) * fy,
                    fx * fy};
-  /* Depth-aware weights are bilinear[k] / e[k], e[k] = EPS + depth difference in [0.01, 1.01],
+  /* Depth-aware weights are bilinear[k] / e[k], e[k] = max(depth difference, EPS) in [0.01, 1],
    * here scaled by e0 e1 e2 e3 (the sum is normalised): products that cannot overflow or
-   * underflow instead of 4 divisions, and one reciprocal of their sum. Bilinear weights sum to
-   * exactly 1 at s = 2 and 4: no normalisation. */
+   * underflow instead of 4 divisions, and one reciprocal of their sum. A pixel whose four
+   * differences are all within EPS (its own surface, every e[k] = EPS) takes the bilinear weights
+   * as they are, the value the normalised products have in exact arithmetic: the CPU lanes skip
+   * the products for blocks of such pixels. Bilinear weights sum to exactly 1 at s = 2 and 4: no
+   * normalisation. */
+  int normalise = 0;
   if (depth_aware) {
-    VOL_REAL e[4];
+    VOL_REAL d[4];
     for (int k = 0; k < 4; ++k)
-      e[k] = (VOL_REAL)VOL_UPSAMPLE_EPS +
-             VOL_T(vol_depth_difference)(rho, (VOL_REAL)low_key[(size_t)ys[k] * (size_t)low_width + (size_t)xs[k]]);
-    const VOL_REAL e01 = e[0] * e[1], e23 = e[2] * e[3];
-    w[0] = w[0] * (e[1] * e23);
-    w[1] = w[1] * (e[0] * e23);
-    w[2] = w[2] * (e[3] * e01);
-    w[3] = w[3] * (e[2] * e01);
+      d[k] = VOL_T(vol_depth_difference)(rho, (VOL_REAL)low_key[(size_t)ys[k] * (size_t)low_width + (size_t)xs[k]]);
+    normalise = !(d[0] <= (VOL_REAL)VOL_UPSAMPLE_EPS && d[1] <= (VOL_REAL)VOL_UPSAMPLE_EPS &&
+                  d[2] <= (VOL_REAL)VOL_UPSAMPLE_EPS && d[3] <= (VOL_REAL)VOL_UPSAMPLE_EPS);
+    if (normalise) {
+      VOL_REAL e[4];
+      for (int k = 0; k < 4; ++k) e[k] = d[k] > (VOL_REAL)VOL_UPSAMPLE_EPS ? d[k] : (VOL_REAL)VOL_UPSAMPLE_EPS;
+      const VOL_REAL e01 = e[0] * e[1], e23 = e[2] * e[3];
+      w[0] = w[0] * (e[1] * e23);
+      w[1] = w[1] * (e[0] * e23);
+      w[2] = w[2] * (e[3] * e01);
+      w[3] = w[3] * (e[2] * e01);
+    }
   }
   VOL_V4 tap[4];
   for (int k = 0; k < 4; ++k) {
@@ -103,7 +114,7 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL
   }
   /* Row by row, then normalised: two short chains, and the CPU lanes' division overlaps them. */
   const VOL_V4 sum = VOL_T(vol_fma4)(tap[1], w[1], tap[0] * w[0]) + VOL_T(vol_fma4)(tap[3], w[3], tap[2] * w[2]);
-  return depth_aware ? sum * ((VOL_REAL)1 / ((w[0] + w[1]) + (w[2] + w[3]))) : sum;
+  return normalise ? sum * ((VOL_REAL)1 / ((w[0] + w[1]) + (w[2] + w[3]))) : sum;
 }
 
 /* One channel over the fog (docs/volumetric.md §Resolution, upsampling, composite): P + c (1 - A),

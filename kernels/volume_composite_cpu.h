@@ -89,22 +89,41 @@ static inline float16 vol_inverse_eye_depth_v(float16 raw, global const float* f
   return select(select((float16)VOL_RHO_SKY, rho, rho > VOL_RHO_SKY), (float16)VOL_RHO_SKY, sky);
 }
 
-/* vol_depth_difference (volume_composite.h) lane-wise, its key already capped (vol_capped_keys_v). */
+/* vol_depth_difference (volume_composite.h) lane-wise, in two steps: x = 1 - k rho of a capped key
+ * (vol_capped_keys_v), then the difference min(|x|, 1). */
 static inline float16 vol_capped_keys_v(float16 k) { return select((float16)VOL_KEY_SKY, k, k < VOL_KEY_SKY); }
-static inline float16 vol_depth_difference_v(float16 rho, float16 key) {
-  const float16 x = fma(-key, rho, (float16)1.0f);
+static inline float16 vol_depth_x_v(float16 rho, float16 key) { return fma(-key, rho, (float16)1.0f); }
 #if defined(FOG_AVX512) && defined(__AVX512DQ__)
-  /* min(|x|, 1) as one vrangeps (of x and 1 the smaller magnitude, sign cleared), not and + min:
-   * -4..8 % for depth-aware RGBA16F. A NaN x (k rho = 0 inf: a key of 0 and rho = inf, at an
-   * orthographic near plane at 0) is a quiet NaN, and vrangeps gives the other operand for a
-   * quiet NaN and a number (Intel SDM, VRANGEPS, "Signaling of Comparison Operations"): 1, as
-   * the select does. */
-  return __builtin_bit_cast(float16, __builtin_ia32_rangeps512_mask(
-      __builtin_bit_cast(fog_v16f, x), __builtin_bit_cast(fog_v16f, (float16)1.0f), 0x0a /* min |.|, sign 0 */,
-      (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
+/* vrangeps: of a and b the smaller (0x0a) or larger (0x0b) magnitude, sign cleared. With a quiet
+ * NaN and a number it gives the number (Intel SDM, VRANGEPS, "Signaling of Comparison
+ * Operations"). */
+#define VOL_RANGE(a, b, imm)                                                                       \
+  __builtin_bit_cast(float16, __builtin_ia32_rangeps512_mask(__builtin_bit_cast(fog_v16f, (a)),    \
+                                                             __builtin_bit_cast(fog_v16f, (b)), (imm), \
+                                                             (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */))
+#endif
+static inline float16 vol_depth_difference_v(float16 x) {
+#if defined(FOG_AVX512) && defined(__AVX512DQ__)
+  /* min(|x|, 1) as one vrangeps, not and + min: -4..8 % for depth-aware RGBA16F. A NaN x (k rho =
+   * 0 inf: a key of 0 and rho = inf, at an orthographic near plane at 0) is a quiet NaN: 1, as the
+   * select does. */
+  return VOL_RANGE(x, (float16)1.0f, 0x0a);
 #else
   const float16 d = fabs(x);
   return select((float16)1.0f, d, d < 1.0f);
+#endif
+}
+
+/* vol_upsample's own-surface test lane-wise: every difference min(|x_k|, 1) <= EPS. With AVX-512
+ * three vrangeps take the largest |x_k| and one compare tests it: a NaN x_k (k rho = 0 inf) has
+ * rho = inf, where every x is NaN or -inf, so the largest is NaN or inf and the test fails as the
+ * differences' (1 > EPS) does. */
+static inline int16 vol_own_surface_v(float16 x0, float16 x1, float16 x2, float16 x3) {
+#if defined(FOG_AVX512) && defined(__AVX512DQ__)
+  return VOL_RANGE(VOL_RANGE(x0, x1, 0x0b), VOL_RANGE(x2, x3, 0x0b), 0x0b) <= VOL_UPSAMPLE_EPS;
+#else
+  return max(max(vol_depth_difference_v(x0), vol_depth_difference_v(x1)),
+             max(vol_depth_difference_v(x2), vol_depth_difference_v(x3))) <= VOL_UPSAMPLE_EPS;
 #endif
 }
 
@@ -252,49 +271,68 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   const float16 bottom_keys = vol_capped_keys_v(vol_window_keys(low_key, bottom, b, low_width, inside));
 #endif
   /* Row r of the s (r a literal or the loop's index, named by the token n): its frame index i0_n and
-   * vol_upsample's weights w0_n .. w3_n, bilinear with vol_upsample_axis' fraction (r + 1/2) / s (a
-   * constant, clamps or not), depth-aware: times the other taps' (EPS + depth difference), with
-   * norm_n the reciprocal of their sum. */
+   * vol_upsample's bilinear weights w0_n .. w3_n with vol_upsample_axis' fraction (r + 1/2) / s (a
+   * constant, clamps or not); depth-aware, also the taps' x0_n .. x3_n (vol_depth_x_v) and own_n,
+   * the pixels whose four differences are within EPS (vol_upsample's bilinear case). */
 #define VOL_ROW_WEIGHTS(n, r)                                                                         \
   const size_t i0_##n = (size_t)(VOL_SCALE * m - VOL_SCALE / 2 + (r)) * (size_t)width + (size_t)x0;   \
   const float fy_##n = ((float)(r) + 0.5f) / (float)VOL_SCALE;                                        \
   float16 w0_##n = (1.0f - fx) * (1.0f - fy_##n), w1_##n = fx * (1.0f - fy_##n),                      \
           w2_##n = (1.0f - fx) * fy_##n, w3_##n = fx * fy_##n;                                        \
-  VOL_DEPTH_WEIGHTS(n)
+  VOL_DEPTH_DIFFERENCES(n)
 #if VOL_DEPTH_AWARE
-#define VOL_E(keys, tap) (VOL_UPSAMPLE_EPS + vol_depth_difference_v(rho, VOL_PIXEL_ORDER(VOL_SHUFFLE(keys, tap))))
+#define VOL_X(keys, tap) vol_depth_x_v(rho, VOL_PIXEL_ORDER(VOL_SHUFFLE(keys, tap)))
+#define VOL_DEPTH_DIFFERENCES(n)                                                                      \
+  float16 x0_##n, x1_##n, x2_##n, x3_##n;                                                             \
+  {                                                                                                   \
+    const float16 rho = vol_inverse_eye_depth_v(VOL_PIXEL_ORDER(vload16(0, depth + i0_##n)), frame);  \
+    x0_##n = VOL_X(top_keys, VOL_LEFT_TAP);                                                           \
+    x1_##n = VOL_X(top_keys, VOL_RIGHT_TAP);                                                          \
+    x2_##n = VOL_X(bottom_keys, VOL_LEFT_TAP);                                                        \
+    x3_##n = VOL_X(bottom_keys, VOL_RIGHT_TAP);                                                       \
+  }                                                                                                   \
+  const int16 own_##n = vol_own_surface_v(x0_##n, x1_##n, x2_##n, x3_##n);
+/* Depth-aware row n where some pixel has a tap off its surface: the weights times the other taps'
+ * e = max(difference, EPS), norm_n the reciprocal of their sum; own_n's pixels keep the bilinear
+ * weights and a norm of 1 (x 1 is exact: their bits are vol_upsample's unnormalised ones). */
+#define VOL_E(x) max(vol_depth_difference_v(x), (float16)VOL_UPSAMPLE_EPS)
 #define VOL_DEPTH_WEIGHTS(n)                                                                          \
   float16 norm_##n;                                                                                   \
   {                                                                                                   \
-    const float16 rho = vol_inverse_eye_depth_v(VOL_PIXEL_ORDER(vload16(0, depth + i0_##n)), frame);  \
-    const float16 e0 = VOL_E(top_keys, VOL_LEFT_TAP), e1 = VOL_E(top_keys, VOL_RIGHT_TAP);            \
-    const float16 e2 = VOL_E(bottom_keys, VOL_LEFT_TAP), e3 = VOL_E(bottom_keys, VOL_RIGHT_TAP);      \
+    const float16 e0 = VOL_E(x0_##n), e1 = VOL_E(x1_##n), e2 = VOL_E(x2_##n), e3 = VOL_E(x3_##n);     \
     const float16 e01 = e0 * e1, e23 = e2 * e3;                                                       \
-    w0_##n *= e1 * e23;                                                                               \
-    w1_##n *= e0 * e23;                                                                               \
-    w2_##n *= e3 * e01;                                                                               \
-    w3_##n *= e2 * e01;                                                                               \
-    norm_##n = 1.0f / ((w0_##n + w1_##n) + (w2_##n + w3_##n));                                        \
+    const float16 p0 = w0_##n * (e1 * e23), p1 = w1_##n * (e0 * e23);                                 \
+    const float16 p2 = w2_##n * (e3 * e01), p3 = w3_##n * (e2 * e01);                                 \
+    norm_##n = select(1.0f / ((p0 + p1) + (p2 + p3)), (float16)1.0f, own_##n);                        \
+    w0_##n = select(p0, w0_##n, own_##n);                                                             \
+    w1_##n = select(p1, w1_##n, own_##n);                                                             \
+    w2_##n = select(p2, w2_##n, own_##n);                                                             \
+    w3_##n = select(p3, w3_##n, own_##n);                                                             \
   }
-#define VOL_NORMALISE(sum, q, n) ((sum) * VOL_QUAD_SPREAD(norm_##n, q))
+#define VOL_ALL_OWN(n) (!VOL_ANY16(~own_##n))
+#define VOL_NORMALISED(sum, q, n) ((sum) * VOL_QUAD_SPREAD(norm_##n, q))
 #else
-#define VOL_DEPTH_WEIGHTS(n)
-#define VOL_NORMALISE(sum, q, n) (sum) /* the bilinear weights sum to exactly 1 */
+#define VOL_DEPTH_DIFFERENCES(n)
 #endif
+#define VOL_AS_IS(sum, q, n) (sum) /* the bilinear weights sum to exactly 1 */
   /* vol_upsample's sum for quad q of row n: the top row's taps, the bottom row's, their sum,
-   * normalised (last, so the division's latency overlaps the taps' arithmetic). */
-#define VOL_QUAD(q, t, u, n)                                                                          \
+   * normalised (NORM: VOL_NORMALISED or VOL_AS_IS; last, so the division's latency overlaps the
+   * taps' arithmetic). */
+#define VOL_QUAD(q, t, u, n, NORM)                                                                    \
   {                                                                                                   \
     const float16 top_taps = fma(VOL_SHUFFLE(t, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w1_##n, q),          \
                                  VOL_SHUFFLE(t, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w0_##n, q));          \
     const float16 bottom_taps = fma(VOL_SHUFFLE(u, VOL_QUAD_RIGHT), VOL_QUAD_SPREAD(w3_##n, q),       \
                                     VOL_SHUFFLE(u, VOL_QUAD_LEFT) * VOL_QUAD_SPREAD(w2_##n, q));       \
     vol_composite_quad(color_in + 4 * i0_##n, color_out + 4 * i0_##n, q,                              \
-                       VOL_NORMALISE(top_taps + bottom_taps, q, n), stream);                          \
+                       NORM(top_taps + bottom_taps, q, n), stream);                                   \
   }
-#define VOL_ROW_QUADS(n) VOL_QUAD(0, t0, u0, n) VOL_QUAD(1, t1, u1, n) VOL_QUAD(2, t2, u2, n) VOL_QUAD(3, t3, u3, n)
+#define VOL_ROW_QUADS(n, NORM) \
+  VOL_QUAD(0, t0, u0, n, NORM) VOL_QUAD(1, t1, u1, n, NORM) VOL_QUAD(2, t2, u2, n, NORM) VOL_QUAD(3, t3, u3, n, NORM)
   /* All s rows in the frame (every pair but the frame's first and last): the rows' weights first,
-   * then their quads, so that each row's chain (depth, weights, division) overlaps the others'. */
+   * then their quads, so that each row's chain (depth, weights, division) overlaps the others'.
+   * Depth-aware blocks all of whose pixels are on their taps' surface (most of a frame: 84 % of
+   * the 1080p demo's) are bilinear: no products, no division, no normalisation. */
   if (first == VOL_SCALE * m - VOL_SCALE / 2 && last == VOL_SCALE * m + VOL_SCALE / 2) {
     VOL_ROW_WEIGHTS(0, 0)
     VOL_ROW_WEIGHTS(1, 1)
@@ -302,11 +340,33 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
     VOL_ROW_WEIGHTS(2, 2)
     VOL_ROW_WEIGHTS(3, 3)
 #endif
-    VOL_ROW_QUADS(0)
-    VOL_ROW_QUADS(1)
+#if VOL_DEPTH_AWARE
 #if VOL_SCALE == 4
-    VOL_ROW_QUADS(2)
-    VOL_ROW_QUADS(3)
+    const int all_own = VOL_ALL_OWN(0) && VOL_ALL_OWN(1) && VOL_ALL_OWN(2) && VOL_ALL_OWN(3);
+#else
+    const int all_own = VOL_ALL_OWN(0) && VOL_ALL_OWN(1);
+#endif
+    if (!all_own) {
+      VOL_DEPTH_WEIGHTS(0)
+      VOL_DEPTH_WEIGHTS(1)
+#if VOL_SCALE == 4
+      VOL_DEPTH_WEIGHTS(2)
+      VOL_DEPTH_WEIGHTS(3)
+#endif
+      VOL_ROW_QUADS(0, VOL_NORMALISED)
+      VOL_ROW_QUADS(1, VOL_NORMALISED)
+#if VOL_SCALE == 4
+      VOL_ROW_QUADS(2, VOL_NORMALISED)
+      VOL_ROW_QUADS(3, VOL_NORMALISED)
+#endif
+      return;
+    }
+#endif
+    VOL_ROW_QUADS(0, VOL_AS_IS)
+    VOL_ROW_QUADS(1, VOL_AS_IS)
+#if VOL_SCALE == 4
+    VOL_ROW_QUADS(2, VOL_AS_IS)
+    VOL_ROW_QUADS(3, VOL_AS_IS)
 #endif
     return;
   }
@@ -315,14 +375,24 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
     const int y = VOL_SCALE * m - VOL_SCALE / 2 + r;
     if (y < first || y >= last) continue;
     VOL_ROW_WEIGHTS(row, r)
-    VOL_ROW_QUADS(row)
+#if VOL_DEPTH_AWARE
+    VOL_DEPTH_WEIGHTS(row)
+    VOL_ROW_QUADS(row, VOL_NORMALISED)
+#else
+    VOL_ROW_QUADS(row, VOL_AS_IS)
+#endif
   }
 #undef VOL_ROW_QUADS
 #undef VOL_QUAD
 #undef VOL_ROW_WEIGHTS
+#undef VOL_DEPTH_DIFFERENCES
 #undef VOL_DEPTH_WEIGHTS
+#undef VOL_X
+#undef VOL_RANGE
 #undef VOL_E
-#undef VOL_NORMALISE
+#undef VOL_ALL_OWN
+#undef VOL_NORMALISED
+#undef VOL_AS_IS
 }
 #endif
 

@@ -4,7 +4,9 @@
 // one-pixel path GPUs run. Synthetic targets give every case its share: A == 0 (the color's bits
 // pass through, signalling NaNs included), A == 1 (P exactly, NaN/Inf colors hidden), partial A
 // over NaN/Inf colors, sky pixels and sky taps in depth-aware mode, NaN depths, the target's
-// edges (first and last blocks clamp), widths that are not a multiple of 16.
+// edges (first and last blocks clamp), widths that are not a multiple of 16; and scenes of surfaces,
+// where depth-aware pixels whose taps all lie on their own surface take the bilinear weights (the
+// CPU lanes' bilinear blocks) beside blocks with silhouettes.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -14,6 +16,7 @@
 #include <random>
 #include <vector>
 
+#include "fogcl/depth_kinds.h"
 #include "runtime/clhpp.h"
 #include "test_support.h"
 #include "volume/volume_formulas.h"
@@ -27,6 +30,9 @@ enum class Path { lanes, lanes_portable, one_pixel };
 // orthographic_near0: the near plane at 0, where a pixel on it has 1 / eye depth = inf and its block
 // a key of 0: the depth difference's 1 - k rho is NaN (the CPU lanes' vrangeps must give 1 for it).
 enum class View { conventional, reversed, infinite_far, orthographic, orthographic_near0 };
+// random: raw depths at random (no pixel on its taps' surface); surfaces: a slanted plane, a box in
+// front of it and sky above, so that most blocks are on one surface and some straddle a silhouette.
+enum class Depth { random, surfaces };
 
 struct CompositeCase {
   Path path;
@@ -36,6 +42,7 @@ struct CompositeCase {
   View view;
   int width;
   int height = 0;  // 0: 8 s + 5 (odd: the last target row is a bottom tap, not clamped)
+  Depth depth = Depth::random;
 };
 
 std::string name_of(const testing::TestParamInfo<CompositeCase>& info) {
@@ -44,7 +51,7 @@ std::string name_of(const testing::TestParamInfo<CompositeCase>& info) {
   const char* views[] = {"conventional", "reversed", "infinite_far", "orthographic", "orthographic_near0"};
   return std::string(paths[int(c.path)]) + "_s" + std::to_string(c.scale) + (c.depth_aware ? "_aware" : "_bilinear") +
          (c.storage == ColorFormat::rgba16f ? "_f16_" : "_f32_") + views[int(c.view)] + "_w" + std::to_string(c.width) +
-         (c.height ? "_h" + std::to_string(c.height) : "");
+         (c.height ? "_h" + std::to_string(c.height) : "") + (c.depth == Depth::surfaces ? "_surfaces" : "");
 }
 
 std::vector<CompositeCase> all_cases() {
@@ -57,6 +64,12 @@ std::vector<CompositeCase> all_cases() {
     for (Path p : {Path::lanes, Path::one_pixel}) cases.push_back({p, 2, true, ColorFormat::rgba32f, v, 83});
   for (int s : {2, 4}) cases.push_back({Path::lanes, s, true, ColorFormat::rgba16f, View::conventional, 64});
   cases.push_back({Path::lanes, 4, true, ColorFormat::rgba32f, View::conventional, 7});  // a tail only
+  for (Path p : {Path::lanes, Path::lanes_portable, Path::one_pixel})
+    for (int s : {2, 4})
+      for (ColorFormat f : {ColorFormat::rgba32f, ColorFormat::rgba16f})
+        cases.push_back({p, s, true, f, View::conventional, 83, 0, Depth::surfaces});
+  for (View v : {View::reversed, View::orthographic})
+    cases.push_back({Path::lanes, 2, true, ColorFormat::rgba16f, v, 83, 0, Depth::surfaces});
   // Heights whose last work-item's rows clamp their bottom tap to the target's last row (the lanes
   // take the s rows between two target rows per work-item).
   for (int s : {2, 4})
@@ -79,6 +92,20 @@ CameraParams camera_of(View view, int width, int height) {
   return make_camera_params(p);
 }
 
+// Whether vol_upsample gives frame pixel (x, y), of inverse eye depth rho, its bilinear weights as they
+// are: every tap's depth difference within VOL_UPSAMPLE_EPS.
+bool on_own_surface(int x, int y, float rho, const std::vector<float>& low_key, int low_width, int low_height,
+                    int s) {
+  using namespace volume_formulas;
+  int x0, x1, y0, y1;
+  vol_upsample_axis<float>(x, s, low_width, &x0, &x1);
+  vol_upsample_axis<float>(y, s, low_height, &y0, &y1);
+  for (int ty : {y0, y1})
+    for (int tx : {x0, x1})
+      if (!(vol_depth_difference(rho, low_key[std::size_t(ty) * low_width + tx]) <= VOL_UPSAMPLE_EPS)) return false;
+  return true;
+}
+
 class VolumeCompositeKernel : public testing::TestWithParam<CompositeCase> {
  protected:
   void SetUp() override {
@@ -98,13 +125,23 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   std::mt19937 rng(11 + s);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
 
-  // Depth: random raw values, every 7th pixel sky, every 29th NaN, every 11th on the near plane.
+  // Depth: random raw values, every 7th pixel sky, every 29th NaN, every 11th on the near plane; or
+  // surfaces: sky in the top rows, a plane whose eye depth grows by 0.4 % a pixel (taps within
+  // EPS = 1 % of the pixel or not, by their distance), and a box at half its depth.
   DepthImage depth(width, height);
-  for (int i = 0; i < width * height; ++i)
+  for (int i = 0; i < width * height; ++i) {
+    const int x = i % width, y = i / width;
+    if (c.depth == Depth::surfaces) {
+      const bool box = x >= width / 3 && x < width / 3 + 21 && y >= height / 2;
+      const double eye = (box ? 0.5 : 1.0) * 4.0 * (1.0 + 0.004 * x + 0.002 * y);
+      depth.data()[i] = y < s + 1 ? (reversed ? 0.0f : 1.0f) : float(raw_from_eye_depth(eye, cam));
+      continue;
+    }
     depth.data()[i] = i % 29 == 3 ? std::numeric_limits<float>::quiet_NaN()
                       : i % 7 == 0 ? (reversed ? 0.0f : 1.0f)
                       : i % 11 == 5 ? (reversed ? 1.0f : 0.0f)
                                    : unit(rng);
+  }
   // Color: random HDR, and NaN, Inf and signalling NaNs (alpha too) in a pattern.
   ColorImage color(width, height, c.storage);
   const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
@@ -142,7 +179,7 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
       if (band == 1 || (lx + ly) % 9 == 4) a = 1.0f;
       for (int k = 0; k < 3; ++k) low[4 * i + k] = a * unit(rng);
       low[4 * i + 3] = a;
-      low_key[i] = (lx * 3 + ly) % 13 == 0 ? inf
+      low_key[i] = (lx * 3 + ly) % 13 == 0 && c.depth == Depth::random ? inf
                                            : vol_block_eye_depth<float>(depth.data(), lx, ly, s, width, height, projection,
                                                                         reversed, zx, zy, near_plane, far_plane);
     }
@@ -194,12 +231,14 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
   // The formulas: A == 0 and alpha keep the input's bits; else vol_composite, rounded to the storage.
   ColorImage want = color;
   std::size_t clear = 0, opaque = 0, partial = 0, wrong = 0;
+  std::vector<char> own(std::size_t(width) * height, 0);
   const std::size_t bpp = bytes_per_pixel(c.storage);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const std::size_t i = std::size_t(y) * width + x;
       const float rho =
           c.depth_aware && s > 1 ? vol_inverse_eye_depth<float>(depth.data()[i], frame.data(), projection, reversed) : 0.0f;
+      own[i] = c.depth_aware && s > 1 && on_own_surface(x, y, rho, low_key, low_width, low_height, s);
       const glm::vec4 fog = vol_upsample<float>(x, y, rho, low.data(), low_key.data(), low_width, low_height, s,
                                                 c.depth_aware);
       if (fog.w == 0.0f) {
@@ -221,8 +260,26 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
                     w.y, w.z, w.w);
       }
     }
-  std::printf("  %s: %zu clear, %zu opaque, %zu partial pixels, %zu differ (options: %s)\n",
-              name_of({GetParam(), 0}).c_str(), clear, opaque, partial, wrong, options.c_str());
+  // The CPU lanes' blocks (16 pixels of the s rows between two target rows) all of whose pixels
+  // are on their own surface (bilinear, no products) and those with some off it.
+  std::size_t own_pixels = 0, own_blocks = 0, mixed_blocks = 0;
+  for (char o : own) own_pixels += o;
+  for (int m = 0; s > 1 && m <= low_height; ++m)
+    for (int x0 = 0; x0 + 16 <= width; x0 += 16) {
+      int n = 0, total = 0;
+      for (int y = std::max(s * m - s / 2, 0); y < std::min(s * m + s / 2, height); ++y)
+        for (int x = x0; x < x0 + 16; ++x, ++total) n += own[std::size_t(y) * width + x];
+      own_blocks += total > 0 && n == total;
+      mixed_blocks += n > 0 && n < total;
+    }
+  std::printf("  %s: %zu clear, %zu opaque, %zu partial pixels, %zu differ; %zu on their own surface, blocks of "
+              "16 x s: %zu all, %zu some (options: %s)\n",
+              name_of({GetParam(), 0}).c_str(), clear, opaque, partial, wrong, own_pixels, own_blocks, mixed_blocks,
+              options.c_str());
+  if (c.depth == Depth::surfaces) {
+    EXPECT_GT(own_blocks, 2u);
+    EXPECT_GT(mixed_blocks, 2u);
+  }
   EXPECT_GT(clear, std::size_t(width));
   EXPECT_GT(opaque, std::size_t(width));
   EXPECT_GT(partial, std::size_t(width));
@@ -293,6 +350,47 @@ TEST(VolumeDepthSimilarity, OwnDepthIsSimilarAndSkyIsNot) {
     }
   std::printf("  worst difference of a pixel's own depth: %.3g (relative; EPS is 0.01)\n", worst);
   EXPECT_LT(worst, 1e-5f);
+}
+
+// vol_upsample's depth-aware weights bilinear_k / max(difference_k, EPS): a pixel whose four taps are
+// within EPS of its depth (one surface) gets the bilinear result bit for bit; just past EPS the
+// result moves continuously from it; a tap across a silhouette (difference 1) keeps 1/100 of the
+// weight it would have on the surface.
+TEST(VolumeDepthSimilarity, OwnSurfaceTakesTheBilinearWeights) {
+  using namespace volume_formulas;
+  // A 2 x 2 target; frame pixel (1, 1) at s = 2 samples all four with fractions 1/4.
+  const std::vector<float> low = {0.1f, 0.2f, 0.3f, 0.5f, 0.9f, 0.1f, 0.4f, 0.7f,
+                                  0.3f, 0.6f, 0.2f, 0.25f, 0.8f, 0.8f, 0.1f, 0.9f};
+  const float rho = 0.1f;  // eye depth 10
+  const auto upsample = [&](std::array<double, 4> delta, bool aware) {
+    std::vector<float> keys(4);
+    for (int k = 0; k < 4; ++k) keys[k] = float(10.0 * (1.0 + delta[k]));
+    return vol_upsample<float>(1, 1, rho, low.data(), keys.data(), 2, 2, 2, aware);
+  };
+  const glm::vec4 bilinear = upsample({0, 0, 0, 0}, false);
+  const std::array<double, 4> within = {0.005, -0.009, 0.0, 0.0099};
+  const glm::vec4 on_surface = upsample(within, true);
+  EXPECT_EQ(std::memcmp(&on_surface, &bilinear, sizeof bilinear), 0);
+  // Just past the tolerance: the normalised products differ from bilinear by about 1e-4 of a weight.
+  const glm::vec4 past = upsample({0.005, -0.009, 0.0, 0.0100015}, true);
+  float jump = 0;
+  for (int c = 0; c < 4; ++c) jump = std::max(jump, std::fabs(past[c] - bilinear[c]));
+  // Across a silhouette: tap 3 twice as far (difference 1), against the weights in double.
+  const glm::vec4 across = upsample({0.005, -0.009, 0.0, 1.0}, true);
+  const double b[4] = {0.5625, 0.1875, 0.1875, 0.0625}, e[4] = {0.01, 0.01, 0.01, 1.0};
+  double sum = 0;
+  for (int k = 0; k < 4; ++k) sum += b[k] / e[k];
+  float worst = 0;
+  for (int c = 0; c < 4; ++c) {
+    double want = 0;
+    for (int k = 0; k < 4; ++k) want += b[k] / e[k] / sum * double(low[4 * k + c]);
+    worst = std::max(worst, float(std::fabs(double(across[c]) - want)));
+  }
+  std::printf("  one surface: bilinear bits; just past EPS: %.3g from bilinear; across a silhouette: %.3g from double\n",
+              jump, worst);
+  EXPECT_GT(jump, 0.0f);
+  EXPECT_LT(jump, 1e-4f);
+  EXPECT_LT(worst, 1e-6f);
 }
 
 }  // namespace

@@ -64,9 +64,11 @@ TEST(VolumeReport, RowsAreSaneAndFilesAreWritten) {
     EXPECT_LE(row.p999_abs_err, row.max_abs_err) << row.scene << " " << row.variant;
     EXPECT_GE(row.pct_8bit_off, 0.0);
     EXPECT_LE(row.pct_8bit_off, 100.0);
-    // Thin media keep their digits: sigma_t * diameter = 1e-4 changes colors by ~1e-5 at most.
+    // Thin media keep their digits: sigma_t * diameter = 1e-4 changes colors by ~1e-4 at most; at full
+    // resolution the error is float rounding (measured 1.0e-6 at most), at half resolution it is the
+    // resolution's, a fraction of that change (measured 1.0e-5 on this 32 x 18 frame).
     if (row.scene == "thin") {
-      EXPECT_LE(row.max_abs_err, 1e-5) << row.variant;
+      EXPECT_LE(row.max_abs_err, row.divisor == 1 ? 2e-6 : 2e-5) << row.variant;
     }
   }
 
