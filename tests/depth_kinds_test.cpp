@@ -25,6 +25,14 @@ double linear_eye_depth(double raw, const CameraParams& p) {
   return 1.0 / (double(p.zbuffer_params.z) * raw + double(p.zbuffer_params.w));
 }
 
+// |ray(u, v)| / view z of pixel (x, y) of a w x h frame, from the camera's geometry (not its corners).
+double ray_length(const PerspectiveCamera& cam, int x, int y, int w, int h) {
+  const double tan_v = std::tan(double(cam.fov_y_deg) * 3.14159265358979323846 / 360.0);
+  const double u = (x + 0.5) / w, v = 1.0 - (y + 0.5) / h;
+  const double rx = (2 * u - 1) * tan_v * double(cam.aspect), ry = (2 * v - 1) * tan_v;
+  return std::sqrt(rx * rx + ry * ry + 1.0);
+}
+
 TEST(DepthKinds, EyeDepthRoundTripsThroughLinearEyeDepth) {
   for (bool reversed : {false, true}) {
     const CameraParams p = make_camera_params(camera(reversed));
@@ -58,12 +66,7 @@ TEST(DepthKinds, DistanceIsDividedByThePixelsRayLength) {
   const CameraParams p = make_camera_params(cam);
   const int w = 33, h = 21;
   DepthImage d(w, h);
-  const double tan_v = std::tan(double(cam.fov_y_deg) * 3.14159265358979323846 / 360.0);
-  const auto ray_len = [&](int x, int y) {  // |ray| / far from the camera's geometry
-    const double u = (x + 0.5) / w, v = 1.0 - (y + 0.5) / h;
-    const double rx = (2 * u - 1) * tan_v * double(cam.aspect), ry = (2 * v - 1) * tan_v;
-    return std::sqrt(rx * rx + ry * ry + 1.0);
-  };
+  const auto ray_len = [&](int x, int y) { return ray_length(cam, x, y, w, h); };
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) d.at(x, y) = float((1.0 + (17 * (x + y * w)) % 900) * ray_len(x, y));
   d.at(0, 0) = std::numeric_limits<float>::infinity();
@@ -131,13 +134,10 @@ TEST(DepthKinds, OrthographicAndInfiniteFarRoundTrip) {
   const int w = 9, h = 5;
   DepthImage d(w, h, 42.0f);
   to_raw_depth(d, DepthKind::distance, p);
-  const double tan_v = std::tan(double(c.fov_y_deg) * 3.14159265358979323846 / 360.0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const double u = (x + 0.5) / w, v = 1.0 - (y + 0.5) / h;
-      const double rx = (2 * u - 1) * tan_v * double(c.aspect), ry = (2 * v - 1) * tan_v;
       const double eye = double(p.near_plane()) / double(d.at(x, y));
-      EXPECT_NEAR(eye * std::sqrt(rx * rx + ry * ry + 1.0), 42.0, 42.0 * 1e-6) << x << ", " << y;
+      EXPECT_NEAR(eye * ray_length(c, x, y, w, h), 42.0, 42.0 * 1e-6) << x << ", " << y;
     }
 }
 
