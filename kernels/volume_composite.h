@@ -93,10 +93,10 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL
   int normalise = 0;
   if (depth_aware) {
     VOL_REAL d[4];
-    for (int k = 0; k < 4; ++k)
+    for (int k = 0; k < 4; ++k) {
       d[k] = VOL_T(vol_depth_difference)(rho, (VOL_REAL)low_key[(size_t)ys[k] * (size_t)low_width + (size_t)xs[k]]);
-    normalise = !(d[0] <= (VOL_REAL)VOL_UPSAMPLE_EPS && d[1] <= (VOL_REAL)VOL_UPSAMPLE_EPS &&
-                  d[2] <= (VOL_REAL)VOL_UPSAMPLE_EPS && d[3] <= (VOL_REAL)VOL_UPSAMPLE_EPS);
+      normalise |= d[k] > (VOL_REAL)VOL_UPSAMPLE_EPS; /* d is never NaN */
+    }
     if (normalise) {
       VOL_REAL e[4];
       for (int k = 0; k < 4; ++k) e[k] = d[k] > (VOL_REAL)VOL_UPSAMPLE_EPS ? d[k] : (VOL_REAL)VOL_UPSAMPLE_EPS;

@@ -329,45 +329,30 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
   }
 #define VOL_ROW_QUADS(n, NORM) \
   VOL_QUAD(0, t0, u0, n, NORM) VOL_QUAD(1, t1, u1, n, NORM) VOL_QUAD(2, t2, u2, n, NORM) VOL_QUAD(3, t3, u3, n, NORM)
+  /* The s rows of the straight path, each macro X applied to row r = 0 .. s - 1 (named r too). */
+#if VOL_SCALE == 4
+#define VOL_EACH_ROW(X) X(0) X(1) X(2) X(3)
+#else
+#define VOL_EACH_ROW(X) X(0) X(1)
+#endif
+#define VOL_ROW_WEIGHTS_AT(r) VOL_ROW_WEIGHTS(r, r)
+#define VOL_AND_ALL_OWN(n) && VOL_ALL_OWN(n)
+#define VOL_ROW_QUADS_NORMALISED(n) VOL_ROW_QUADS(n, VOL_NORMALISED)
+#define VOL_ROW_QUADS_AS_IS(n) VOL_ROW_QUADS(n, VOL_AS_IS)
   /* All s rows in the frame (every pair but the frame's first and last): the rows' weights first,
    * then their quads, so that each row's chain (depth, weights, division) overlaps the others'.
    * Depth-aware blocks all of whose pixels are on their taps' surface (most of a frame: 84 % of
    * the 1080p demo's) are bilinear: no products, no division, no normalisation. */
   if (first == VOL_SCALE * m - VOL_SCALE / 2 && last == VOL_SCALE * m + VOL_SCALE / 2) {
-    VOL_ROW_WEIGHTS(0, 0)
-    VOL_ROW_WEIGHTS(1, 1)
-#if VOL_SCALE == 4
-    VOL_ROW_WEIGHTS(2, 2)
-    VOL_ROW_WEIGHTS(3, 3)
-#endif
+    VOL_EACH_ROW(VOL_ROW_WEIGHTS_AT)
 #if VOL_DEPTH_AWARE
-#if VOL_SCALE == 4
-    const int all_own = VOL_ALL_OWN(0) && VOL_ALL_OWN(1) && VOL_ALL_OWN(2) && VOL_ALL_OWN(3);
-#else
-    const int all_own = VOL_ALL_OWN(0) && VOL_ALL_OWN(1);
-#endif
-    if (!all_own) {
-      VOL_DEPTH_WEIGHTS(0)
-      VOL_DEPTH_WEIGHTS(1)
-#if VOL_SCALE == 4
-      VOL_DEPTH_WEIGHTS(2)
-      VOL_DEPTH_WEIGHTS(3)
-#endif
-      VOL_ROW_QUADS(0, VOL_NORMALISED)
-      VOL_ROW_QUADS(1, VOL_NORMALISED)
-#if VOL_SCALE == 4
-      VOL_ROW_QUADS(2, VOL_NORMALISED)
-      VOL_ROW_QUADS(3, VOL_NORMALISED)
-#endif
+    if (!(1 VOL_EACH_ROW(VOL_AND_ALL_OWN))) {
+      VOL_EACH_ROW(VOL_DEPTH_WEIGHTS)
+      VOL_EACH_ROW(VOL_ROW_QUADS_NORMALISED)
       return;
     }
 #endif
-    VOL_ROW_QUADS(0, VOL_AS_IS)
-    VOL_ROW_QUADS(1, VOL_AS_IS)
-#if VOL_SCALE == 4
-    VOL_ROW_QUADS(2, VOL_AS_IS)
-    VOL_ROW_QUADS(3, VOL_AS_IS)
-#endif
+    VOL_EACH_ROW(VOL_ROW_QUADS_AS_IS)
     return;
   }
 #pragma unroll
@@ -383,6 +368,11 @@ static inline void vol_composite16(global const COLOR_T* color_in, global const 
 #endif
   }
 #undef VOL_ROW_QUADS
+#undef VOL_EACH_ROW
+#undef VOL_ROW_WEIGHTS_AT
+#undef VOL_AND_ALL_OWN
+#undef VOL_ROW_QUADS_NORMALISED
+#undef VOL_ROW_QUADS_AS_IS
 #undef VOL_QUAD
 #undef VOL_ROW_WEIGHTS
 #undef VOL_DEPTH_DIFFERENCES
