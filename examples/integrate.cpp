@@ -1,4 +1,4 @@
-// fogcl inside a renderer's own OpenCL pipeline (README "Integrating fogcl"):
+// fogcl inside a renderer's own OpenCL pipeline (docs/library.md, "Integrating fogcl into a renderer"):
 //  - the renderer owns the context, the queue and the frame's buffers, and configures CLHPP its
 //    own way (here: OpenCL 3.0 target, exceptions off; see CMakeLists.txt);
 //  - its own kernel renders color (RGBA16F) and raw depth into those buffers;

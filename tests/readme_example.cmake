@@ -1,6 +1,7 @@
-# Checks that README.md's integration snippet (the C++ block after "<!-- integration-core -->")
-# is the region of examples/integrate.cpp between "// [integration-core]" and
-# "// [integration-core-end]", so the README shows code that compiles and runs in the test suite.
+# Checks that the integration snippet of the Markdown file README (docs/library.md: the C++ block
+# after "<!-- integration-core -->") is the region of examples/integrate.cpp between
+# "// [integration-core]" and "// [integration-core-end]", so the manual shows code that compiles
+# and runs in the test suite.
 file(READ ${EXAMPLE} example)
 string(REGEX MATCH "// \\[integration-core\\]\n(.*)\n[ ]*// \\[integration-core-end\\]" _ "${example}")
 set(core "${CMAKE_MATCH_1}")
@@ -15,9 +16,9 @@ if(snippet STREQUAL "")
   message(FATAL_ERROR "${README} has no <!-- integration-core --> ```cpp ... ``` <!-- integration-core-end --> block")
 endif()
 if(NOT snippet STREQUAL core)
-  message(FATAL_ERROR "README.md's integration snippet differs from examples/integrate.cpp's core:\n--- README\n${snippet}\n--- example\n${core}")
+  message(FATAL_ERROR "${README}'s integration snippet differs from examples/integrate.cpp's core:\n--- ${README}\n${snippet}\n--- example\n${core}")
 endif()
 string(REGEX MATCHALL "\n" lines "${core}")
 list(LENGTH lines n)
 math(EXPR n "${n} + 1")
-message("README integration snippet = examples/integrate.cpp core (${n} lines)")
+message("${README} integration snippet = examples/integrate.cpp core (${n} lines)")
