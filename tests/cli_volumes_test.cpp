@@ -378,13 +378,14 @@ struct BadCase {
   std::string what;                 // the case, for failure messages
   std::string args;                 // appended to the base arguments (or replacing them, see below)
   std::vector<std::string> expect;  // parts the message must contain
+  int code = 1;                     // 1 for a value that breaks a rule, 2 for a required flag left out
 };
 
 void expect_rejected(const std::string& args, const std::string& out, const BadCase& c) {
   fs::remove(out);
   const CliRun r = run_cli(args + " --out " + out);
   std::printf("[ message  ] %-28s %s", c.what.c_str(), r.output.c_str());
-  EXPECT_EQ(r.exit_code, 1) << c.what << ": " << r.output;
+  EXPECT_EQ(r.exit_code, c.code) << c.what << ": " << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << c.what << ": " << r.output;
   for (const std::string& part : c.expect)
     EXPECT_NE(r.output.find(part), std::string::npos) << c.what << ": lacks '" << part << "' in " << r.output;
@@ -477,6 +478,7 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
     std::string what;
     std::map<std::string, std::string> change;
     std::vector<std::string> expect;
+    int code = 1;
   } changed[] = {
       {"zero forward", {{"--forward", "0,0,0"}}, {"--forward", "non-zero", "0,0,0"}},
       {"up parallel to forward", {{"--forward", "0,0,1"}, {"--up", "0,0,-2"}}, {"parallel", "(0, 0, -2)", "(0, 0, 1)"}},
@@ -485,16 +487,17 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
       {"two numbers", {{"--forward", "0,1"}}, {"--forward", "three comma-separated numbers", "0,1"}},
       {"zero light", {{"--light-dir", "0,0,0"}}, {"--light-dir", "non-zero"}},
       {"negative light", {{"--light-color", "1,-1,1"}}, {"--light-color", ">= 0"}},
-      {"missing --eye", {{"--eye", ""}}, {"--eye is required with --volumes"}},
-      {"missing --forward", {{"--forward", ""}}, {"--forward is required with --volumes"}},
-      {"missing --up", {{"--up", ""}}, {"--up is required with --volumes"}},
+      {"missing --eye", {{"--eye", ""}}, {"--eye is required with --volumes"}, 2},
+      {"missing --forward", {{"--forward", ""}}, {"--forward is required with --volumes"}, 2},
+      {"missing --up", {{"--up", ""}}, {"--up is required with --volumes"}, 2},
       {"no mode, no volumes",
        {{"--volumes", ""}, {"--eye", ""}, {"--forward", ""}, {"--up", ""}, {"--light-dir", ""}, {"--light-color", ""}},
-       {"--mode is required"}},
+       {"--mode is required"},
+       2},
       {"volume flag without --volumes", {{"--volumes", ""}, {"--mode", "exp"}}, {"--eye needs --volumes"}},
   };
   for (const auto& c : changed)
-    expect_rejected(base_args(c.change) + " --device scalar", in("bad.exr"), {c.what, "", c.expect});
+    expect_rejected(base_args(c.change) + " --device scalar", in("bad.exr"), {c.what, "", c.expect, c.code});
 
   const std::string base = base_args() + " --device scalar";
   const BadCase cases[] = {

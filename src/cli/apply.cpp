@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -24,6 +25,7 @@
 #include <OpenEXR/ImfThreading.h>
 
 #include "cli/cli.h"
+#include "cli/file_checks.h"
 #include "cli/frame_pipeline.h"
 #include "cli/sequence.h"
 #include "cli/volumes_cli.h"
@@ -39,6 +41,14 @@ namespace {
 struct FramePaths {
   std::string color, depth, out, png;
 };
+
+// A frame's files before it is read (cli/file_checks.h): no output replaces an input or another
+// output, every destination can be written.
+void check_frame_files(const ApplyOptions& o, const FramePaths& p) {
+  check_files({{"--color", p.color}, {"--depth", p.depth}, {"--volumes", o.volumes.volumes_path},
+               {"--shadow-map", o.volumes.shadow_map_path}},
+              {{"--out", p.out}, {"--png", p.png}});
+}
 
 // The camera of one frame: flags win over the color file's worldToNDC / worldToCamera.
 PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std::string* from) {
@@ -354,20 +364,28 @@ void write_frame(const ApplyOptions& o, FrameJob& job) {
   ExrWriteOptions w;
   w.half = o.pixel_type == "half";
   w.compression = o.compression.empty() ? -1 : parse_exr_compression(o.compression);
+  // Both files are written completely before either replaces its destination: a preview that
+  // fails leaves the EXR's destination as it was (and a frame fogged in place unfogged).
+  detail::WriteBatch batch;
   write_exr_output(job.paths.out, job.out, job.color, o.rgba_only, w);
   if (!job.paths.png.empty()) write_png_preview(job.paths.png, job.out);
+  batch.commit();
 }
 
 // Set by SIGINT / SIGTERM during a sequence: stop after the write in progress.
 std::atomic<int> g_interrupt{0};
-extern "C" void on_interrupt(int signo) { g_interrupt.store(signo); }
+// A second signal ends the process at once, by that signal; a write then in progress leaves
+// nothing either: an unnamed temporary vanishes with the process, a named one is removed here.
+extern "C" void on_interrupt(int signo) {
+  if (g_interrupt.exchange(signo) == 0) return;
+  detail::remove_temporaries_now();
+  ::signal(signo, SIG_DFL);
+  ::raise(signo);
+}
 
-// The handlers reset themselves (SA_RESETHAND): a second Ctrl-C ends the process at once (a write
-// then in progress leaves nothing either: atomic_file.h).
 void catch_interrupts() {
   struct sigaction action {};
   action.sa_handler = on_interrupt;
-  action.sa_flags = SA_RESETHAND;
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
@@ -378,6 +396,18 @@ int available_cores() {
   cpu_set_t set;
   if (sched_getaffinity(0, sizeof set, &set) == 0) return std::max(1, CPU_COUNT(&set));
   return std::max(1u, std::thread::hardware_concurrency());
+}
+
+// A frame name too long to appear whole in its temporary's name (atomic_file.h's
+// temporary_key) is known by its leading bytes `head`: they must begin a frame name (stem, digits,
+// suffix).
+bool begins_frame_name(const std::string& head, const std::string& stem, const std::string& suffix) {
+  if (head.size() <= stem.size()) return stem.compare(0, head.size(), head) == 0;
+  if (head.compare(0, stem.size(), stem) != 0) return false;
+  for (std::size_t end = stem.size() + 1; end <= head.size() && std::isdigit(static_cast<unsigned char>(head[end - 1]));
+       ++end)
+    if (end == head.size() || suffix.compare(0, head.size() - end, head, end) == 0) return true;
+  return false;
 }
 
 // The temporaries that killed runs left next to this sequence's outputs (atomic_file.h): only
@@ -391,6 +421,7 @@ int sweep_stale_temporaries(const FramePattern& pattern) {
   stem.pop_back();
   const std::string& suffix = pattern.suffix;
   return detail::remove_stale_temporaries(dir, [&](const std::string& target) {
+    if (std::string head; detail::is_shortened_temporary_key(target, &head)) return begins_frame_name(head, stem, suffix);
     if (target.size() <= stem.size() + suffix.size() || target.compare(0, stem.size(), stem) != 0 ||
         target.compare(target.size() - suffix.size(), suffix.size(), suffix) != 0)
       return false;
@@ -432,6 +463,9 @@ int run_apply(const ApplyOptions& o) {
     if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
     FrameJob job;
     job.paths = {o.color_path, o.depth_path, o.out_path, o.png_path};
+    check_frame_files(o, job.paths);  // before anything is read or written
+    const int swept = detail::remove_stale_temporaries_of({o.out_path, o.png_path});
+    if (o.verbose && swept > 0) std::fprintf(stderr, "removed %d stale temporary file(s) of killed runs\n", swept);
     std::future<void> reading = std::async(std::launch::async, [&] { read_frame(o, job); });
     std::promise<std::shared_ptr<Devices>> opened;
     open_devices(o, opened);
@@ -450,6 +484,10 @@ int run_apply(const ApplyOptions& o) {
   const std::vector<int> frames = o.frames.empty() ? frames_on_disk(color) : parse_frame_range(o.frames);
   if (frames.empty()) throw Error("'" + o.color_path + "': no frames found (give --frames FIRST-LAST)");
 
+  // The files every frame reads (each frame's own are checked as it is read).
+  check_files({{"--depth", depth.is_sequence ? "" : o.depth_path}, {"--volumes", o.volumes.volumes_path},
+               {"--shadow-map", o.volumes.shadow_map_path}},
+              {});
   const int swept = sweep_stale_temporaries(out) + (o.png_path.empty() ? 0 : sweep_stale_temporaries(png));
   // One device, one context, one program cache for every frame: opened by the pipeline's start
   // (this thread) while the first frames go through, taken by the fog stage when it needs it
@@ -501,6 +539,7 @@ int run_apply(const ApplyOptions& o) {
     InputFrames spare = spare_inputs.take();
     const bool first = f == frames.front();
     try {
+      check_frame_files(o, job.paths);
       read_frame(o, job, &spare);
     } catch (...) {
       if (first && tiered) first_variant.set_value(std::nullopt);

@@ -1,7 +1,14 @@
+#include <stdlib.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <exception>
+#include <filesystem>
 #include <functional>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <OpenEXR/IlmThreadPool.h>
@@ -25,12 +32,63 @@ class RowsTask : public IlmThread::Task {
 
 int pool_threads() { return IlmThread::ThreadPool::globalThreadPool().numThreads(); }
 
+// PoCL keeps its compiled kernels in a cache folder: POCL_CACHE_DIR, else
+// $XDG_CACHE_HOME/pocl/kcache, else $HOME/.cache/pocl/kcache (PoCL's lib/CL/pocl_cache.c). If it
+// cannot create that folder its platform offers no device ("no OpenCL device matches 'cpu' ...
+// available: none"); if it cannot write in it, every program build fails with a bare
+// CL_BUILD_PROGRAM_FAILURE. Returns the one line that says which, "" when the folder is usable
+// (or no variable names one).
+std::string pocl_cache_problem() {
+  std::string dir, from;
+  const auto env = [](const char* name) -> const char* {
+    const char* v = std::getenv(name);
+    return v != nullptr && *v != '\0' ? v : nullptr;
+  };
+  if (const char* d = env("POCL_CACHE_DIR")) {
+    dir = d, from = "POCL_CACHE_DIR";
+  } else if (const char* x = env("XDG_CACHE_HOME")) {
+    dir = std::string(x) + "/pocl/kcache", from = "XDG_CACHE_HOME";
+  } else if (const char* h = env("HOME")) {
+    dir = std::string(h) + "/.cache/pocl/kcache", from = "HOME";
+  } else {
+    return "";
+  }
+  std::string why;
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec)) {
+    why = "is not a folder";
+  } else if (std::filesystem::create_directories(dir, ec); ec) {
+    why = "cannot be created (" + ec.message() + ")";
+  } else {
+    std::string probe = dir + "/.fogcl-write-test-XXXXXX";
+    const int fd = ::mkstemp(probe.data());
+    if (fd < 0) {
+      why = std::string("cannot be written (") + std::strerror(errno) + ")";
+    } else {
+      ::close(fd);
+      ::unlink(probe.c_str());
+    }
+  }
+  if (why.empty()) return "";
+  return "PoCL (the OpenCL CPU driver) cannot use its kernel cache folder '" + dir + "' (from " + from + "): it " + why +
+         "; set POCL_CACHE_DIR to a writable folder, or use --device scalar";
+}
+
 }  // namespace
 
 Backend::Backend(const std::string& choice) {
   const std::string resolved = resolve_device_choice(choice);
   if (resolved == "scalar") return;
-  runtime_ = std::make_unique<Runtime>(resolved);
+  try {
+    runtime_ = std::make_unique<Runtime>(resolved);
+  } catch (const Error&) {
+    // A PoCL that could not start offers no device: say why instead of "available: none".
+    if (const std::string problem = pocl_cache_problem(); !problem.empty()) throw Error(problem);
+    throw;
+  }
+  // Its builds would fail one by one, each with a build log that does not say why.
+  if (device_is_pocl_cpu(runtime_->device()))
+    if (const std::string problem = pocl_cache_problem(); !problem.empty()) throw Error(problem);
   pass_ = std::make_unique<FogPass>(*runtime_);
 }
 

@@ -8,6 +8,8 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.h"
+#include "cli/usage.h"
+#include "io/atomic_file.h"
 
 namespace {
 
@@ -26,15 +28,18 @@ const char* kDeviceHelp =
 }  // namespace
 
 int main(int argc, char** argv) {
+  fogcl::detail::remove_temporaries_on_signals();  // a killed run leaves no temporary file
   CLI::App app{"fogcl: deferred fog (Unity linear/exp/exp2) on OpenCL devices and in C++"};
   app.require_subcommand(1);
+  app.footer(fogcl::cli::exit_codes_help());
 
+  const CLI::Validator kPixels = fogcl::cli::integer_in(1, 16384, "in [1, 16384]");
   fogcl::cli::DemoOptions demo;
   CLI::App* demo_cmd = app.add_subcommand(
       "demo", "Render the built-in scene, fog it in several settings on OpenCL and in C++, write EXR + PNG, print timings and errors");
   demo_cmd->add_option("--out", demo.out_dir, "Output folder")->capture_default_str();
-  demo_cmd->add_option("--width", demo.width, "Image width [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
-  demo_cmd->add_option("--height", demo.height, "Image height [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
+  demo_cmd->add_option("--width", demo.width, "Image width [pixels]")->check(kPixels)->capture_default_str();
+  demo_cmd->add_option("--height", demo.height, "Image height [pixels]")->check(kPixels)->capture_default_str();
   demo_cmd->add_option("--device", demo.device, kDeviceHelp);
 
   fogcl::cli::ApplyOptions ap;
@@ -66,7 +71,8 @@ int main(int argc, char** argv) {
                       "Sequences: continue past a bad frame, list the failures at the end (exit code still 1)");
   apply_cmd->add_option("--threads", ap.threads,
                         "Threads that compress and decompress EXR data (OpenEXR's pool) and run PoCL's "
-                        "device, 1 to 4096 (default: every core this process may use)");
+                        "device, 1 to 4096 (default: every core this process may use)")
+      ->check(fogcl::cli::integer_in(1, 4096, "between 1 and 4096"));
   apply_cmd->add_option("--pixel-type", ap.pixel_type,
                         "Output R, G, B, A as float (default) or half; half input written as half keeps "
                         "unfogged pixels bit for bit")
@@ -119,26 +125,40 @@ int main(int argc, char** argv) {
       "scenes, against the float64 path; writes report.csv, report.json and the Pareto plot report.png");
   report_cmd->add_option("--out", report.out_dir, "Output folder")->capture_default_str();
   report_cmd->add_option("--device", report.device, kDeviceHelp);
-  report_cmd->add_option("--width", report.width, "Frame width [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
-  report_cmd->add_option("--height", report.height, "Frame height [pixels]")->check(CLI::Range(1, 16384))->capture_default_str();
+  report_cmd->add_option("--width", report.width, "Frame width [pixels]")->check(kPixels)->capture_default_str();
+  report_cmd->add_option("--height", report.height, "Frame height [pixels]")->check(kPixels)->capture_default_str();
   report_cmd->add_option("--runs", report.runs,
                          "Timed runs per row (the median is reported), >= 7 (default 9); --volumetric: >= 3 "
-                         "(default 5)");
+                         "(default 5)")
+      ->check(fogcl::cli::integer_in(1, 1000, "in [1, 1000] (>= 7 for the deferred report, >= 3 with --volumetric)"));
   report_cmd->add_flag("--volumetric", report.volumetric,
                        "The volumetric pass instead: steps x resolution x upsampling x noise sampling x integrator x "
                        "storage on four volume scenes against the scalar<double> march at 4096 steps (default frame "
                        "160x90); writes volume-report.csv, .json and .png");
   report_cmd->add_option("--steps", report.steps, "--volumetric: only these step counts, e.g. 16,32 (default all six)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(fogcl::cli::integer_in(1, 4096, "in [1, 4096]"));
   report_cmd->add_option("--scenes", report.scenes, "--volumetric: only these of demo,dense,thin,inside")
       ->delimiter(',');
   report_cmd->add_option("--integrators", report.integrators, "--volumetric: only these of stylized,physical")
       ->delimiter(',');
 
+  for (CLI::App* command : {demo_cmd, apply_cmd, report_cmd}) command->footer(fogcl::cli::exit_codes_help());
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help prints the help (exit 0). Anything else is one line like every other error: a value
+    // that breaks a flag's rule (a range, a list of names) exit 1, a malformed command line exit 2.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    const bool rule = dynamic_cast<const CLI::ValidationError*>(&e) != nullptr;
+    std::string message = fogcl::detail::one_line(e.what());
+    // CLI11 writes "--steps: must be ..."; fogcl's own rule messages read "--steps must be ...".
+    if (const std::size_t at = message.find(": must be "); rule && at != std::string::npos) message.erase(at, 1);
+    if (app.get_subcommands().empty() && argc > 1 && argv[1][0] != '-')
+      message = "unknown command '" + std::string(argv[1]) + "' (the commands are demo, apply and report)";
+    std::fprintf(stderr, "fogcl: error: %s%s\n", message.c_str(), rule ? "" : " (see --help)");
+    return rule ? fogcl::cli::kExitError : fogcl::cli::kExitUsage;
   }
 
   try {
@@ -161,7 +181,7 @@ int main(int argc, char** argv) {
     fogcl::cli::note_given_volume_flags(*apply_cmd, ap.volumes);
     // With volumes the deferred fog is optional: no --mode runs only the volumetric pass.
     if (apply_cmd->count("--mode") == 0) {
-      if (ap.volumes.volumes_path.empty()) throw fogcl::Error("--mode is required (off, linear, exp or exp2)");
+      if (ap.volumes.volumes_path.empty()) throw fogcl::cli::UsageError("--mode is required (off, linear, exp or exp2)");
       mode = "off";
     }
     ap.precision_given = apply_cmd->count("--precision") > 0;
@@ -171,9 +191,14 @@ int main(int argc, char** argv) {
     if (apply_cmd->count("--threads") > 0 && ap.threads < 1)
       throw fogcl::Error("--threads must be between 1 and 4096 (got " + std::to_string(ap.threads) + ")");
     if (apply_cmd->count("--far") == 0 && !ap.infinite_far)
-      throw fogcl::Error("--far is required (except with --infinite-far)");
+      throw fogcl::cli::UsageError("--far is required (except with --infinite-far)");
     if (apply_cmd->count("--ortho-size") > 0 && !(ap.ortho_size > 0.0f && std::isfinite(ap.ortho_size)))
       throw fogcl::Error("--ortho-size must be finite and > 0 (got " + std::to_string(ap.ortho_size) + ")");
+    // Not given is 0 in ApplyOptions: a given 0 must not read as "no --fov given".
+    if (apply_cmd->count("--fov") > 0 && !(ap.fov > 0.0f && ap.fov < 180.0f))
+      throw fogcl::Error("--fov must be in (0, 180) degrees (got " + fogcl::cli::flag_value(*apply_cmd, "--fov") + ")");
+    if (apply_cmd->count("--aspect") > 0 && !(ap.aspect > 0.0f && std::isfinite(ap.aspect)))
+      throw fogcl::Error("--aspect must be finite and > 0 (got " + fogcl::cli::flag_value(*apply_cmd, "--aspect") + ")");
     if (apply_cmd->count("--fov") > 0 && apply_cmd->count("--ortho-size") > 0)
       throw fogcl::Error("give either --fov (perspective) or --ortho-size (orthographic), not both");
     if (ap.infinite_far) ap.reversed_z = true;  // an infinite far plane exists only in reversed Z
@@ -182,8 +207,11 @@ int main(int argc, char** argv) {
     ap.settings.metric = apply_cmd->count("--distance") > 0 ? FogMetric::distance : FogMetric::depth;
     if (!fog_color.empty()) ap.settings.color = glm::vec3(fog_color[0], fog_color[1], fog_color[2]);
     return fogcl::cli::run_apply(ap);
+  } catch (const fogcl::cli::UsageError& e) {
+    std::fprintf(stderr, "fogcl: error: %s\n", e.what());
+    return fogcl::cli::kExitUsage;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fogcl: error: %s\n", e.what());
-    return 1;
+    return fogcl::cli::kExitError;
   }
 }

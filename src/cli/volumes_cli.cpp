@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cli/usage.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/volume_report.h"
 #include "fogcl/volume_scalar.h"
@@ -72,6 +73,23 @@ const std::map<std::string, Member>& volume_fields() {
       {"ambient", &FogVolume::ambient},
   };
   return fields;
+}
+
+// A key from the file as a message quotes it: control bytes (a NUL would end the message) as JSON
+// escapes, cut to stay one short line.
+std::string key_text(const std::string& key) {
+  std::string s;
+  for (const char c : key) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
+      s += buf;
+    } else {
+      s += c;
+    }
+  }
+  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  return s;
 }
 
 // Levenshtein distance, for "did you mean" on an unknown key.
@@ -153,7 +171,7 @@ FogVolume parse_volume(const json& j, const KeyReader& r) {
         const std::size_t d = edit_distance(key, f.first);
         if (d < best_d) best = f.first, best_d = d;
       }
-      throw Error(r.where + "unknown key '" + key + "' (" + (best.empty() ? "" : "did you mean '" + best + "'? ") +
+      throw Error(r.where + "unknown key '" + key_text(key) + "' (" + (best.empty() ? "" : "did you mean '" + best + "'? ") +
                   "the keys are FogVolume's fields in snake_case, README 'VOLUMES.json')");
     }
     std::visit(
@@ -183,8 +201,8 @@ struct ParseContext {
 
   std::string where() const {
     if (top_key == "volumes" && volume >= 0)
-      return "volume " + std::to_string(volume) + (volume_key.empty() ? "" : ": '" + volume_key + "'");
-    return top_key.empty() ? "top level" : "top level: '" + top_key + "'";
+      return "volume " + std::to_string(volume) + (volume_key.empty() ? "" : ": '" + key_text(volume_key) + "'");
+    return top_key.empty() ? "top level" : "top level: '" + key_text(top_key) + "'";
   }
 };
 
@@ -209,7 +227,7 @@ std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::st
         // nlohmann keeps the last of repeated keys; a repeat is almost always a mistake.
         if (!ctx.keys.empty() && !ctx.keys.back().insert(key).second && ctx.duplicate.empty())
           ctx.duplicate = (depth == 3 ? "volume " + std::to_string(ctx.volume) + ": " : std::string()) +
-                          "duplicate key '" + key + "' (each key may appear once)";
+                          "duplicate key '" + key_text(key) + "' (each key may appear once)";
         break;
       }
       default:
@@ -237,7 +255,8 @@ std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::st
   if (!doc.is_object())
     throw Error(name + ": the top level must be an object {\"volumes\": [...]} (got " + shown(doc) + ")");
   for (const auto& [key, value] : doc.items())
-    if (key != "volumes") throw Error(name + ": top level: unknown key '" + key + "' (the only key is \"volumes\")");
+    if (key != "volumes")
+      throw Error(name + ": top level: unknown key '" + key_text(key) + "' (the only key is \"volumes\")");
   if (!doc.contains("volumes")) throw Error(name + ": top level: 'volumes' is missing (expected {\"volumes\": [...]})");
   const json& list = doc["volumes"];
   if (!list.is_array())
@@ -371,7 +390,9 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
       ->capture_default_str()
       ->group(group);
   app.add_option("--time", o.time, "Noise scroll time [s] (default 0; sequences: frame number / --fps)")->group(group);
-  app.add_option("--frame", o.frame, "Jitter frame index >= 0 (default 0; sequences: the frame number)")->group(group);
+  app.add_option("--frame", o.frame, "Jitter frame index >= 0 (default 0; sequences: the frame number)")
+      ->check(integer_in(0, 4294967295LL, "in [0, 4294967295]"))
+      ->group(group);
   app.add_option("--fps", o.fps, "Sequences: frames per second for the default --time, > 0")
       ->capture_default_str()
       ->group(group);
@@ -379,7 +400,10 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
       ->transform(CLI::IsMember(kIntegrators, CLI::ignore_case))
       ->capture_default_str()
       ->group(group);
-  app.add_option("--steps", o.steps, "March steps per ray, in [1, 4096]")->capture_default_str()->group(group);
+  app.add_option("--steps", o.steps, "March steps per ray, in [1, 4096]")
+      ->check(integer_in(1, 4096, "in [1, 4096]"))
+      ->capture_default_str()
+      ->group(group);
   app.add_option("--volume-resolution", o.resolution, "March target: full, half or quarter resolution")
       ->transform(CLI::IsMember(kResolutions, CLI::ignore_case))
       ->capture_default_str()
@@ -389,9 +413,13 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
       ->capture_default_str()
       ->group(group);
   app.add_option("--noise-size", o.noise_size, "Noise texels per side: 32, 64 or 128")
+      ->check(integer_in(32, 128, "32, 64 or 128"))
       ->capture_default_str()
       ->group(group);
-  app.add_option("--noise-seed", o.noise_seed, "Noise seed, in [0, 4294967295]")->capture_default_str()->group(group);
+  app.add_option("--noise-seed", o.noise_seed, "Noise seed, in [0, 4294967295]")
+      ->check(integer_in(0, 4294967295LL, "in [0, 4294967295]"))
+      ->capture_default_str()
+      ->group(group);
   app.add_option("--noise-sampling", o.noise_sampling,
                  "buffer (trilinear in the kernel) or image (OpenCL 3D image, hardware filtering on GPUs)")
       ->transform(CLI::IsMember(kSamplings, CLI::ignore_case))
@@ -475,7 +503,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     return nullptr;
   }
   for (const char* flag : {"--eye", "--forward", "--up"})
-    if (!given(o, flag)) throw Error(std::string(flag) + " is required with --volumes (the camera pose, X,Y,Z)");
+    if (!given(o, flag)) throw UsageError(std::string(flag) + " is required with --volumes (the camera pose, X,Y,Z)");
   auto stage = std::unique_ptr<VolumeStage>(new VolumeStage);
   VolumeStage& s = *stage;
   s.options_ = o;

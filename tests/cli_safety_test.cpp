@@ -1,0 +1,579 @@
+// The fogcl CLI never loses a file and fails in one clear line: outputs that would replace an input
+// or another output (by device and inode: links and other spellings count), destinations that are
+// not regular files, the mode and group of a rewritten output, a frame's EXR and PNG committed
+// together, named temporaries removed on SIGINT / SIGTERM and swept after a kill, long output
+// names, and the message and exit code of each misuse (1 for a rule, 2 for a usage error).
+#include <fcntl.h>
+#include <grp.h>
+#include <limits.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/sysmacros.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <thread>
+#include <vector>
+
+#include "fogcl/demo_scene.h"
+#include "fogcl/exr_io.h"
+#include "io/atomic_file.h"
+#include "test_support.h"
+
+namespace fogcl::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string read_bytes(const std::string& p) {
+  std::ifstream f(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
+void write_text(const std::string& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+std::vector<std::string> temporaries_in(const std::string& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().find(".tmp-") != std::string::npos) found.push_back(e.path().filename().string());
+  return found;
+}
+
+std::string host_tag() {
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  return host;
+}
+
+const std::string kNoFov = " --near 0.3 --far 1000 --mode exp2 --density 0.03 --device scalar";
+const std::string kFog = kNoFov + " --fov 60";
+
+class CliSafety : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    base_ = temp_dir() + "/cli-safety-" + std::to_string(::getpid());
+    fs::remove_all(base_);
+    fs::create_directories(base_);
+    PerspectiveCamera camera;
+    camera.fov_y_deg = 60.0f;
+    const DemoFrame frame = render_demo_scene(64, 36, camera, DemoView{});
+    write_exr_rgba(base_ + "/color.exr", frame.color);
+    write_exr_depth(base_ + "/depth.exr", frame.depth);
+    write_text(base_ + "/volumes.json", R"({"volumes": [{"center": [0, 1, 4], "radius": 2}]})");
+    write_text(base_ + "/shadow.exr", read_bytes(base_ + "/depth.exr"));
+  }
+  static void TearDownTestSuite() { fs::remove_all(base_); }
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = base_ + "/" + info->name();
+    fs::create_directories(dir_);
+    for (const char* f : {"color.exr", "depth.exr", "volumes.json", "shadow.exr"})
+      fs::copy_file(base_ + "/" + f, dir_ + "/" + f);
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  // apply on this test's color + depth.
+  std::string apply(const std::string& more) const {
+    return "apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " " + more;
+  }
+  // The same without --fov.
+  std::string apply_no_fov(const std::string& more) const {
+    return "apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kNoFov + " " + more;
+  }
+  std::string volume_flags() const {
+    return " --volumes " + path("volumes.json") + " --eye 0,1.6,-6 --forward 0,0,1 --up 0,1,0";
+  }
+  static inline std::string base_;
+  std::string dir_;
+};
+
+// Every pair of an output and an input (or another output), each spelled as given, through a
+// symbolic link, a hard link and another spelling: refused with one line, exit 1, the file intact.
+TEST_F(CliSafety, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
+  fs::create_symlink(path("color.exr"), path("link-to-color.exr"));
+  fs::create_symlink(path("depth.exr"), path("link-to-depth.exr"));
+  fs::create_hard_link(path("depth.exr"), path("hard-depth.exr"));
+  fs::create_hard_link(path("volumes.json"), path("hard-volumes.json"));
+  write_text(path("old-out.exr"), read_bytes(path("color.exr")));
+  fs::create_hard_link(path("old-out.exr"), path("hard-old-out.exr"));
+  const std::string shadow = " --shadow-map " + path("shadow.exr") + " --light-view-proj 1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1";
+  const std::string rel = fs::relative(path("depth.exr")).string();
+  const struct {
+    std::string args, says, protects;
+  } cases[] = {
+      {"--out " + path("depth.exr"), "--out '" + path("depth.exr") + "' is the same file as --depth", "depth.exr"},
+      {"--out " + path("volumes.json") + volume_flags(), "is the same file as --volumes", "volumes.json"},
+      {"--out " + path("shadow.exr") + volume_flags() + shadow, "is the same file as --shadow-map", "shadow.exr"},
+      {"--out " + path("o.exr") + " --png " + path("color.exr"), "--png '" + path("color.exr") + "' is the same file as --color",
+       "color.exr"},
+      {"--out " + path("o.exr") + " --png " + path("depth.exr"), "is the same file as --depth", "depth.exr"},
+      {"--out " + path("o.exr") + " --png " + path("volumes.json") + volume_flags(), "is the same file as --volumes",
+       "volumes.json"},
+      {"--out " + path("old-out.exr") + " --png " + path("old-out.exr"), "is the same file as --out", "old-out.exr"},
+      // Not by spelling: links and another path to the same file.
+      {"--out " + path("o.exr") + " --png " + path("link-to-color.exr"), "is the same file as --color", "color.exr"},
+      {"--out " + path("link-to-depth.exr"), "is the same file as --depth", "depth.exr"},
+      {"--out " + path("hard-depth.exr"), "is the same file as --depth", "depth.exr"},
+      {"--out " + path("hard-volumes.json") + volume_flags(), "is the same file as --volumes", "volumes.json"},
+      {"--out " + path("old-out.exr") + " --png " + path("hard-old-out.exr"), "is the same file as --out",
+       "old-out.exr"},
+      {"--out " + rel, "is the same file as --depth", "depth.exr"},
+      {"--out " + dir_ + "/../" + fs::path(dir_).filename().string() + "/depth.exr", "is the same file as --depth",
+       "depth.exr"},
+      // Two outputs that do not exist yet, spelled differently.
+      {"--out " + path("new.exr") + " --png " + dir_ + "/./new.exr", "is the same file as --out", ""},
+  };
+  for (const auto& c : cases) {
+    const std::string before = c.protects.empty() ? "" : read_bytes(path(c.protects));
+    const CliRun r = run_cli(apply(c.args));
+    std::printf("[ refused  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+    if (!c.protects.empty()) {
+      EXPECT_TRUE(read_bytes(path(c.protects)) == before) << c.protects << " changed";
+    }
+    EXPECT_FALSE(fs::exists(path("o.exr")));
+    EXPECT_FALSE(fs::exists(path("new.exr")));
+  }
+  EXPECT_TRUE(fs::is_symlink(path("link-to-depth.exr")));
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+}
+
+// Fogging --color in place stays allowed, also through a link; a link as --out is written
+// through (the file it names is replaced, the link stays).
+TEST_F(CliSafety, FoggingColorInPlaceStaysAllowed) {
+  const std::string before = read_bytes(path("color.exr"));
+  CliRun r = run_cli("apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --out " +
+                     path("color.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string once = read_bytes(path("color.exr"));
+  EXPECT_NE(once, before) << "the color file was not fogged in place";
+  fs::create_symlink(path("color.exr"), path("link.exr"));
+  r = run_cli("apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --out " +
+              path("link.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::is_symlink(path("link.exr")));
+  EXPECT_NE(read_bytes(path("color.exr")), once) << "the file the link names was not fogged";
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+}
+
+// A destination that exists and is not a regular file is refused, never replaced.
+TEST_F(CliSafety, ADestinationThatIsNotARegularFileIsRefused) {
+  ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0644), 0);
+  fs::create_directories(path("folder.exr"));
+  fs::create_symlink(path("missing.exr"), path("dangling.exr"));
+  const int sock = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  const std::string sock_path = path("sock");
+  const bool have_socket = sock >= 0 && sock_path.size() < sizeof addr.sun_path &&
+                           (std::snprintf(addr.sun_path, sizeof addr.sun_path, "%s", sock_path.c_str()),
+                            ::bind(sock, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0);
+  struct Case {
+    std::string args, says;
+  };
+  std::vector<Case> cases = {
+      {"--out " + path("fifo"), "--out '" + path("fifo") + "': it is a FIFO (named pipe), not a regular file"},
+      {"--out " + path("o.exr") + " --png " + path("fifo"), "--png '" + path("fifo") + "': it is a FIFO"},
+      {"--out " + path("folder.exr"), "it is a directory"},
+      {"--out " + path("dangling.exr"), "it is a symbolic link to '" + path("missing.exr") + "', which does not exist"},
+      {"--out " + path("no-such-folder/o.exr"), "the folder '" + path("no-such-folder") + "' does not exist"},
+      {"--out " + path("color.exr/o.exr"), "'" + path("color.exr") + "' is not a folder"},
+  };
+  if (have_socket) cases.push_back({"--out " + path("sock"), "it is a socket"});
+  const bool root = ::geteuid() == 0;
+  if (root) {  // a device node: what replaced /dev/null before
+    ASSERT_EQ(::mknod(path("null").c_str(), S_IFCHR | 0666, makedev(1, 3)), 0);
+    cases.push_back({"--out " + path("null"), "it is a character device"});
+  }
+  for (const Case& c : cases) {
+    const CliRun r = run_cli(apply(c.args));
+    std::printf("[ refused  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+  }
+  struct stat st {};
+  ASSERT_EQ(::stat(path("fifo").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  if (root) {
+    ASSERT_EQ(::stat(path("null").c_str(), &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode));
+  } else {
+    std::printf("[ skipped  ] the device node case needs root (mknod)\n");
+  }
+  if (sock >= 0) ::close(sock);
+  EXPECT_TRUE(fs::is_directory(path("folder.exr")));
+  EXPECT_FALSE(fs::exists(path("o.exr")));
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+}
+
+// A rewritten output keeps its mode and group, with unnamed and with named temporaries.
+TEST_F(CliSafety, ARewrittenOutputKeepsItsModeAndGroup) {
+  // A group other than ours: any as root, else a supplementary group if the user has one.
+  gid_t other = ::getegid();
+  if (::geteuid() == 0) {
+    other = ::getegid() == 4242 ? 4243 : 4242;
+  } else {
+    std::vector<gid_t> groups(std::size_t(std::max(0, ::getgroups(0, nullptr))));
+    if (!groups.empty() && ::getgroups(int(groups.size()), groups.data()) >= 0)
+      for (gid_t g : groups)
+        if (g != ::getegid()) other = g;
+  }
+  for (const char* mode : {"", "FOGCL_TEMP_FILES=named"}) {
+    SCOPED_TRACE(*mode ? mode : "unnamed temporaries");
+    const std::string out = path(std::string("kept") + (*mode ? "-named" : "") + ".exr");
+    const std::string png = path(std::string("kept") + (*mode ? "-named" : "") + ".png");
+    for (const std::string& f : {out, png}) {
+      write_text(f, "old");
+      ASSERT_EQ(::chmod(f.c_str(), 0640), 0);
+      if (other != ::getegid()) {
+        ASSERT_EQ(::chown(f.c_str(), uid_t(-1), other), 0);
+      }
+    }
+    const CliRun r = run_cli(apply("--out " + out + " --png " + png), mode);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const std::string& f : {out, png}) {
+      struct stat st {};
+      ASSERT_EQ(::stat(f.c_str(), &st), 0);
+      std::printf("[ kept     ] %s: mode %04o (want 0640), group %d (want %d)\n", fs::path(f).filename().c_str(),
+                  unsigned(st.st_mode & 07777), int(st.st_gid), int(other));
+      EXPECT_EQ(st.st_mode & 07777, 0640u) << f;
+      EXPECT_EQ(st.st_gid, other) << f;
+      EXPECT_NE(read_bytes(f), "old") << f << " was not rewritten";
+    }
+  }
+  if (other == ::getegid()) std::printf("[ skipped  ] the group case: this user has no second group\n");
+}
+
+// A frame's EXR and PNG are committed together: a preview that cannot be written leaves the EXR's
+// destination as it was, whether the folder is missing (found before any work) or the file system
+// refuses the file once both are written (the batch: nothing is committed).
+TEST_F(CliSafety, AFailedPreviewLeavesTheExrDestinationUntouched) {
+  for (const char* mode : {"", "FOGCL_TEMP_FILES=named"}) {
+    SCOPED_TRACE(*mode ? mode : "unnamed temporaries");
+    write_text(path("out.exr"), "the previous output");
+    CliRun r = run_cli(apply("--out " + path("out.exr") + " --png " + path("missing/p.png")), mode);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("the folder '" + path("missing") + "' does not exist"), std::string::npos) << r.output;
+    EXPECT_EQ(read_bytes(path("out.exr")), "the previous output");
+    // /proc takes no new file: the PNG fails when it is prepared, after the EXR was.
+    r = run_cli(apply("--out " + path("out.exr") + " --png /proc/fogcl-safety-test.png"), mode);
+    std::printf("[ refused  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find("/proc/fogcl-safety-test.png: cannot write PNG"), std::string::npos) << r.output;
+    EXPECT_EQ(read_bytes(path("out.exr")), "the previous output");
+    EXPECT_TRUE(temporaries_in(dir_).empty());
+    // In place: a rerun after such a failure must not fog twice.
+    const std::string color = read_bytes(path("color.exr"));
+    r = run_cli("apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --out " +
+                    path("color.exr") + " --png /proc/fogcl-safety-test.png",
+                mode);
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_TRUE(read_bytes(path("color.exr")) == color) << "the color file was fogged although the run failed";
+  }
+}
+
+// The batch itself: the second file fails, the first is not committed; both commit together.
+TEST_F(CliSafety, AWriteBatchCommitsAllOrNothing) {
+  for (const bool named : {false, true}) {
+    SCOPED_TRACE(named ? "named temporaries" : "unnamed temporaries");
+    if (named) ::setenv("FOGCL_TEMP_FILES", "named", 1);
+    const auto write = [](const std::string& p, const std::string& text) {
+      detail::write_file_atomically(p, "TEXT", [&](std::ostream& out, const std::string&) { out << text; });
+    };
+    write_text(path("a.txt"), "old a");
+    try {
+      detail::WriteBatch batch;
+      write(path("a.txt"), "new a");
+      EXPECT_EQ(read_bytes(path("a.txt")), "old a") << "replaced before the commit";
+      write(path("missing/b.txt"), "new b");
+      batch.commit();
+      ADD_FAILURE() << "the second write did not fail";
+    } catch (const Error& e) {
+      std::printf("[ failed   ] %s\n", e.what());
+      EXPECT_NE(std::string(e.what()).find("the folder '" + path("missing") + "' does not exist"), std::string::npos)
+          << e.what();
+    }
+    EXPECT_EQ(read_bytes(path("a.txt")), "old a");
+    EXPECT_TRUE(temporaries_in(dir_).empty());
+    {
+      detail::WriteBatch batch;
+      write(path("a.txt"), "new a");
+      write(path("b.txt"), "new b");
+      batch.commit();
+    }
+    EXPECT_EQ(read_bytes(path("a.txt")), "new a");
+    EXPECT_EQ(read_bytes(path("b.txt")), "new b");
+    EXPECT_TRUE(temporaries_in(dir_).empty());
+    fs::remove(path("b.txt"));
+    ::unsetenv("FOGCL_TEMP_FILES");
+  }
+}
+
+// Named temporaries (the NFS mode) get names within NAME_MAX for long output names; a single-file
+// run sweeps the stale ones of its own outputs as a sequence does, and leaves others alone.
+TEST_F(CliSafety, NamedTemporariesFitLongNamesAndSingleFilesSweepTheirOwn) {
+  const std::string long_name = std::string(246, 'n') + ".exr";  // 250 bytes
+  ASSERT_EQ(long_name.size(), 250u);
+  CliRun r = run_cli(apply("--out " + path(long_name)), "FOGCL_TEMP_FILES=named");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(path(long_name)));
+  const std::string key = detail::temporary_key(long_name);
+  const std::string longest_temp = key + ".tmp-" + std::string(64, 'h') + "-4294967295-18446744073709551615";
+  std::printf("[ measured ] a 250-byte name's temporary key: %zu bytes; longest temporary name %zu bytes (NAME_MAX %d)\n",
+              key.size(), longest_temp.size(), NAME_MAX);
+  EXPECT_LE(longest_temp.size(), std::size_t(NAME_MAX));
+  EXPECT_EQ(detail::temporary_key("short.exr"), "short.exr");
+  EXPECT_NE(detail::temporary_key(std::string(246, 'n') + ".png"), key);  // the hash tells them apart
+
+  // Stale temporaries of a killed writer (pid 2^22 + 1: above Linux's default pid_max).
+  const std::string dead = "-" + host_tag() + "-4194305-0";
+  const std::string mine = "o.exr.tmp" + dead, mine_png = "o.png.tmp" + dead, mine_long = key + ".tmp" + dead;
+  const std::string other = "other.exr.tmp" + dead, remote = "o.exr.tmp-some-other-host-4194305-0";
+  for (const std::string& f : {mine, mine_png, mine_long, other, remote}) write_text(path(f), "partial");
+  r = run_cli(apply("--verbose --out " + path("o.exr") + " --png " + path("o.png")), "FOGCL_TEMP_FILES=named");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("removed 2 stale temporary file(s)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path(mine)));
+  EXPECT_FALSE(fs::exists(path(mine_png)));
+  EXPECT_TRUE(fs::exists(path(mine_long)));  // another output's
+  EXPECT_TRUE(fs::exists(path(other)));
+  EXPECT_TRUE(fs::exists(path(remote)));  // another machine's: maybe still writing
+  r = run_cli(apply("--verbose --out " + path(long_name)), "FOGCL_TEMP_FILES=named");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("removed 1 stale temporary file(s)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path(mine_long)));
+}
+
+// ---- Signals with named temporaries ------------------------------------------------------------
+
+pid_t spawn(const std::string& args, const std::string& log) {
+  std::vector<std::string> words{cli_path()};
+  for (std::size_t at = 0; at < args.size();) {
+    const std::size_t end = std::min(args.find(' ', at), args.size());
+    if (end > at) words.push_back(args.substr(at, end - at));
+    at = end + 1;
+  }
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    ::setenv("FOGCL_TEMP_FILES", "named", 1);
+    restore_start_opencl_env();
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Whether `pid` has a named temporary open in `dir`.
+bool writing_in(pid_t pid, const std::string& dir) {
+  std::error_code ec;
+  for (fs::directory_iterator it("/proc/" + std::to_string(pid) + "/fd", ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code link_ec;
+    const std::string target = fs::read_symlink(it->path(), link_ec).string();
+    if (!link_ec && target.compare(0, dir.size() + 1, dir + "/") == 0 && target.find(".tmp-") != std::string::npos)
+      return true;
+  }
+  return false;
+}
+
+// How a run ended: "exit N" or "signal N".
+std::string ending(int status) {
+  return WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
+                           : WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) : "?";
+}
+
+// Starts the CLI and sends `signals` while a named temporary is open, 2 ms apart (so that each is
+// handled before the next: two pending SIGINTs would merge into one); *status as waitpid gives it.
+// False if the run ended before a write was caught.
+bool signal_mid_write(const std::string& args, const std::string& dir, const std::string& log,
+                      const std::vector<int>& signals, int* status) {
+  const pid_t pid = spawn(args, log);
+  for (;;) {
+    if (writing_in(pid, dir)) break;
+    if (::waitpid(pid, status, WNOHANG) == pid) return false;
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    ::kill(pid, signals[i]);
+  }
+  ::waitpid(pid, status, 0);
+  return true;
+}
+
+TEST_F(CliSafety, SignalsLeaveNoNamedTemporary) {
+  fs::create_directories(path("in"));
+  fs::create_directories(path("out"));
+  for (int f = 1; f <= 8; ++f) {
+    DemoView view;
+    view.eye.z += 0.1f * float(f);
+    PerspectiveCamera camera;
+    camera.fov_y_deg = 60.0f;
+    const DemoFrame frame = render_demo_scene(480, 270, camera, view);
+    char name[64];
+    std::snprintf(name, sizeof name, "in/color.%04d.exr", f);
+    write_exr_rgba(path(name), frame.color);
+    std::snprintf(name, sizeof name, "in/depth.%04d.exr", f);
+    write_exr_depth(path(name), frame.depth);
+  }
+  const std::string sequence = "apply --color " + path("in/color.####.exr") + " --depth " + path("in/depth.####.exr") +
+                               kFog + " --threads 1 --out " + path("out/o.####.exr") + " --png " + path("out/o.####.png");
+  const std::string single = "apply --color " + path("in/color.0001.exr") + " --depth " + path("in/depth.0001.exr") +
+                             kFog + " --threads 1 --out " + path("out/single.exr") + " --png " + path("out/single.png");
+  // One signal in a sequence: the write in progress completes, the run exits 128 + N. A second
+  // signal, or one in a single-file run: the process ends by that signal at once. Either way no
+  // temporary is left.
+  const struct {
+    const char* what;
+    std::string args;
+    std::vector<int> signals;
+    std::string ends;
+  } cases[] = {
+      {"sequence, SIGTERM", sequence, {SIGTERM}, "exit 143"},
+      {"sequence, SIGINT", sequence, {SIGINT}, "exit 130"},
+      {"sequence, double Ctrl-C", sequence, {SIGINT, SIGINT}, "signal 2"},
+      {"sequence, SIGINT then SIGTERM", sequence, {SIGINT, SIGTERM}, "signal 15"},
+      {"single file, SIGTERM", single, {SIGTERM}, "signal 15"},
+      {"single file, SIGINT", single, {SIGINT}, "signal 2"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    std::string ends;
+    // A run may finish between the signals (or before a write is caught): tried up to 5 times.
+    for (int attempt = 0; attempt < 5 && ends != c.ends; ++attempt) {
+      for (const auto& e : fs::directory_iterator(path("out"))) fs::remove(e.path());
+      int status = 0;
+      ends = signal_mid_write(c.args, path("out"), path("log.txt"), c.signals, &status) ? ending(status) : "no write caught";
+      const std::vector<std::string> left = temporaries_in(path("out"));
+      std::printf("[ signal   ] %s: %s, %zu temporary file(s) left\n", c.what, ends.c_str(), left.size());
+      for (const std::string& f : left) ADD_FAILURE() << "left behind: " << f;
+    }
+    EXPECT_EQ(ends, c.ends) << read_bytes(path("log.txt"));
+  }
+}
+
+// ---- Messages and exit codes -----------------------------------------------------------------------
+
+TEST_F(CliSafety, EachMisuseSaysWhatInOneLineWithItsExitCode) {
+  fs::create_directories(path("a-folder"));
+  write_text(path("nul-key.json"), std::string(R"({"volumes": [{"center": [0, 1, 4], "radius": 2, "ra\u0000dius": 1}]})"));
+  write_text(path("nul-top.json"), std::string(R"({"vol\u0000umes": []})"));
+  const std::string out = " --out " + path("o.exr");
+  const struct {
+    std::string args, says;
+    int code;
+  } cases[] = {
+      // Rules: exit 1.
+      {apply_no_fov("--fov 0" + out), "--fov must be in (0, 180) degrees (got 0)", 1},
+      {apply_no_fov("--fov -5" + out), "--fov must be in (0, 180) degrees (got -5)", 1},
+      {apply("--aspect 0" + out), "--aspect must be finite and > 0 (got 0)", 1},
+      {apply("--aspect -2" + out), "--aspect must be finite and > 0 (got -2)", 1},
+      {apply("--threads 99999999999999999999" + out), "--threads must be between 1 and 4096 (got 99999999999999999999)",
+       1},
+      {apply(volume_flags() + " --steps 99999999999999999999" + out),
+       "--steps must be in [1, 4096] (got 99999999999999999999)", 1},
+      {apply(volume_flags() + " --noise-seed 99999999999999999999" + out),
+       "--noise-seed must be in [0, 4294967295] (got 99999999999999999999)", 1},
+      {apply(volume_flags() + " --frame -99999999999999999999" + out),
+       "--frame must be in [0, 4294967295] (got -99999999999999999999)", 1},
+      {"demo --width 0 --out " + path("demo"), "--width must be in [1, 16384] (got 0)", 1},
+      {"report --volumetric --steps 8,99999999999999999999 --out " + path("report"),
+       "--steps must be in [1, 4096] (got 99999999999999999999)", 1},
+      {apply("--mode fog" + out), "--mode: fog not in", 1},
+      {"apply --color " + path("a-folder") + " --near 0.3 --far 1000 --fov 60 --mode exp" + out,
+       "--color '" + path("a-folder") + "': is a directory, not a file", 1},
+      {"apply --color " + path("color.exr") + " --depth " + path("a-folder") + kFog + out,
+       "--depth '" + path("a-folder") + "': is a directory, not a file", 1},
+      {"apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --volumes " + path("a-folder") +
+           " --eye 0,1.6,-6 --forward 0,0,1 --up 0,1,0" + out,
+       "--volumes '" + path("a-folder") + "': is a directory, not a file", 1},
+      {apply("--out " + path("no-folder/o.exr")), "the folder '" + path("no-folder") + "' does not exist", 1},
+      {"apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --volumes " +
+           path("nul-key.json") + " --eye 0,1.6,-6 --forward 0,0,1 --up 0,1,0" + out,
+       "volume 0: unknown key 'ra\\u0000dius' (", 1},
+      {"apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --volumes " +
+           path("nul-top.json") + " --eye 0,1.6,-6 --forward 0,0,1 --up 0,1,0" + out,
+       "top level: unknown key 'vol\\u0000umes' (the only key is \"volumes\")", 1},
+      // Usage errors: exit 2.
+      {apply("--bogus" + out), "fogcl: error: The following argument was not expected: --bogus", 2},
+      {apply_no_fov(out + " --fov"), "--fov", 2},
+      {apply_no_fov("--fov abc" + out), "--fov = abc", 2},
+      {apply("--threads 2x" + out), "--threads = 2x", 2},
+      {apply(out + " --out " + path("p.exr")), "--out", 2},
+      {apply(""), "--out is required", 2},
+      {"apply --color " + path("color.exr") + " --near 0.3 --fov 60 --mode exp" + out,
+       "--far is required (except with --infinite-far)", 2},
+      {"apply --color " + path("color.exr") + " --near 0.3 --far 100 --fov 60" + out, "--mode is required", 2},
+      {"", "A subcommand is required", 2},
+      {"paint", "paint", 2},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli(c.args);
+    std::printf("[ exit %d   ] %s", r.exit_code, r.output.c_str());
+    EXPECT_EQ(r.exit_code, c.code) << c.args << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+  }
+  EXPECT_FALSE(fs::exists(path("o.exr")));
+}
+
+TEST_F(CliSafety, HelpListsTheExitCodesOfEveryCommand) {
+  for (const char* command : {"", "demo ", "apply ", "report "}) {
+    const CliRun r = run_cli(std::string(command) + "--help");
+    EXPECT_EQ(r.exit_code, 0) << command;
+    for (const char* says : {"Exit codes: 0 done; 1 error", "2 usage error", "128+N stopped by signal N"})
+      EXPECT_NE(r.output.find(says), std::string::npos) << command << "--help lacks '" << says << "'";
+  }
+}
+
+// PoCL keeps compiled kernels under HOME (or XDG_CACHE_HOME, or POCL_CACHE_DIR): a folder it cannot
+// create or write is named in one line, not "no OpenCL device matches" or a bare build failure.
+TEST_F(CliSafety, AnUnusablePoclCacheIsNamed) {
+  FOGCL_REQUIRE_DEVICE();
+  if (cli_device() != "cpu") GTEST_SKIP() << "PoCL's CPU device only (FOGCL_DEVICE=" << cli_device() << ")";
+  write_text(path("a-file"), "not a folder");
+  const std::string args = "apply --color " + path("color.exr") + " --depth " + path("depth.exr") +
+                           " --near 0.3 --far 1000 --fov 60 --mode exp --device cpu --out " + path("o.exr");
+  const struct {
+    std::string env, says;
+  } cases[] = {
+      {"env -u XDG_CACHE_HOME -u POCL_CACHE_DIR HOME=/proc/no-home",
+       "PoCL (the OpenCL CPU driver) cannot use its kernel cache folder '/proc/no-home/.cache/pocl/kcache' (from HOME)"},
+      {"env -u XDG_CACHE_HOME POCL_CACHE_DIR=" + path("a-file"),
+       "its kernel cache folder '" + path("a-file") + "' (from POCL_CACHE_DIR): it is not a folder"},
+      {"env -u XDG_CACHE_HOME POCL_CACHE_DIR=/proc", "its kernel cache folder '/proc' (from POCL_CACHE_DIR): it cannot be written"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli(args, c.env);
+    std::printf("[ exit %d   ] %s", r.exit_code, r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.env << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << c.env << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.env << "\n" << r.output;
+  }
+  EXPECT_FALSE(fs::exists(path("o.exr")));
+}
+
+}  // namespace
+}  // namespace fogcl::test
