@@ -151,6 +151,35 @@ TEST_F(CliSafety, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
   EXPECT_TRUE(temporaries_in(dir_).empty());
 }
 
+// The same per frame of a sequence: the frame that would replace its input fails before it is
+// read; fogging the color frames in place stays allowed.
+TEST_F(CliSafety, ASequenceFrameThatWouldReplaceAnInputIsRefused) {
+  fs::copy_file(path("color.exr"), path("c.0001.exr"));
+  fs::copy_file(path("depth.exr"), path("d.0001.exr"));
+  const std::string depth = read_bytes(path("d.0001.exr"));
+  const std::string seq = "apply --color " + path("c.####.exr") + " --depth " + path("d.####.exr") + kFog;
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {" --out " + path("d.####.exr"), "frame 1: --out '" + path("d.0001.exr") + "' is the same file as --depth"},
+      {" --out " + path("o.####.exr") + " --png " + path("o.%04d.exr"),
+       "frame 1: --png '" + path("o.0001.exr") + "' is the same file as --out"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli(seq + c.args);
+    std::printf("[ refused  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_TRUE(read_bytes(path("d.0001.exr")) == depth) << "the depth frame changed";
+    EXPECT_FALSE(fs::exists(path("o.0001.exr")));
+  }
+  const std::string color = read_bytes(path("c.0001.exr"));
+  const CliRun r = run_cli(seq + " --out " + path("c.####.exr"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(read_bytes(path("c.0001.exr")), color) << "the color frame was not fogged in place";
+}
+
 // Fogging --color in place stays allowed, also through a link; a link as --out is written
 // through (the file it names is replaced, the link stays).
 TEST_F(CliSafety, FoggingColorInPlaceStaysAllowed) {
@@ -358,6 +387,27 @@ TEST_F(CliSafety, NamedTemporariesFitLongNamesAndSingleFilesSweepTheirOwn) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("removed 1 stale temporary file(s)"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(path(mine_long)));
+
+  // A sequence whose frame names are too long to appear whole: its shortened temporaries are
+  // known by their leading bytes (the stem, then digits); another sequence's stay.
+  fs::create_directories(path("seq"));
+  fs::copy_file(path("color.exr"), path("seq/c.0001.exr"));
+  fs::copy_file(path("depth.exr"), path("seq/d.0001.exr"));
+  const std::string stem = std::string(120, 's') + ".";
+  const std::string frame_name = stem + "0001" + std::string(120, 'x') + ".exr";
+  const std::string seq_temp = detail::temporary_key(frame_name) + ".tmp" + dead;
+  const std::string others = detail::temporary_key(std::string(120, 't') + ".0001" + std::string(120, 'x') + ".exr") +
+                             ".tmp" + dead;
+  ASSERT_NE(detail::temporary_key(frame_name), frame_name);
+  for (const std::string& f : {seq_temp, others}) write_text(path("seq/" + f), "partial");
+  r = run_cli("apply --color " + path("seq/c.####.exr") + " --depth " + path("seq/d.####.exr") + kFog +
+                  " --verbose --out " + path("seq/" + stem + "####" + std::string(120, 'x') + ".exr"),
+              "FOGCL_TEMP_FILES=named");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("removed 1 stale temporary file(s)"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(path("seq/" + seq_temp)));
+  EXPECT_TRUE(fs::exists(path("seq/" + others)));
+  EXPECT_TRUE(fs::exists(path("seq/" + frame_name)));
 }
 
 // ---- Signals with named temporaries ------------------------------------------------------------
