@@ -28,12 +28,13 @@ gpu-bundle:
 	scripts/gpu-bundle.sh $(BUILD) out/gpu-bundle
 
 # Sanitizer build (clang): the whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer,
-# and the libFuzzer target over EXR loading, from one build folder. detect_leaks=0: PoCL and the
-# OpenCL ICD loader keep process-lifetime allocations (LLVM's JIT state, the platform list) that
-# LeakSanitizer reports at exit; fogcl's own leaks would show in the scalar/IO tests, see README.
+# and the libFuzzer targets over EXR loading and VOLUMES.json, from one build folder.
+# detect_leaks=0: PoCL and the OpenCL ICD loader keep process-lifetime allocations (LLVM's JIT
+# state, the platform list) that LeakSanitizer reports at exit; fogcl's own leaks would show in the
+# scalar/IO tests, see README.
 ASAN_BUILD ?= build-asan
 SANITIZE := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-FUZZ_SECONDS ?= 60
+FUZZ_SECONDS ?= 30
 export ASAN_OPTIONS ?= detect_leaks=0:abort_on_error=1
 export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
 
@@ -50,12 +51,16 @@ asan-build:
 asan-test: asan-build
 	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -E '1920x1080|EightK'
 
-# Bounded fuzz run (FUZZ_SECONDS) from the generated seed corpus; new inputs go to $(ASAN_BUILD)/fuzz-corpus.
+# Bounded fuzz runs (FUZZ_SECONDS each) from the generated seed corpora: EXR loading, then the
+# VOLUMES.json parser (seeded with the demo's volume files); new inputs go to
+# $(ASAN_BUILD)/fuzz-corpus and $(ASAN_BUILD)/fuzz-json-corpus.
 fuzz: asan-build
-	$(ASAN_BUILD)/fuzz/fogcl_make_seeds $(ASAN_BUILD)/fuzz-seeds
-	mkdir -p $(ASAN_BUILD)/fuzz-corpus
+	$(ASAN_BUILD)/fuzz/fogcl_make_seeds $(ASAN_BUILD)/fuzz-seeds $(ASAN_BUILD)/fuzz-json-seeds
+	mkdir -p $(ASAN_BUILD)/fuzz-corpus $(ASAN_BUILD)/fuzz-json-corpus
 	$(ASAN_BUILD)/fuzz/fogcl_exr_fuzzer -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -timeout=10 \
 	  -print_final_stats=1 $(ASAN_BUILD)/fuzz-corpus $(ASAN_BUILD)/fuzz-seeds
+	$(ASAN_BUILD)/fuzz/fogcl_volumes_json_fuzzer -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -timeout=10 \
+	  -dict=fuzz/volumes_json.dict -print_final_stats=1 $(ASAN_BUILD)/fuzz-json-corpus $(ASAN_BUILD)/fuzz-json-seeds
 
 clean:
 	rm -rf $(BUILD) $(ASAN_BUILD) out

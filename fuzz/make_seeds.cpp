@@ -1,19 +1,40 @@
-// Writes the fuzz target's seed corpus: small files of every kind fogcl reads (tests/exr_fixtures.h),
-// so the fuzzer starts from valid multi-part, tiled, layered, windowed, deep, half and float files.
-// Usage: fogcl_make_seeds DIR
+// Writes the fuzz targets' seed corpora: for the EXR target, small files of every kind fogcl reads
+// (tests/exr_fixtures.h), so the fuzzer starts from valid multi-part, tiled, layered, windowed,
+// deep, half and float files; for the VOLUMES.json target, the demo's volume files (what `fogcl
+// demo` writes: volumes.json, volumes-physical.json) and a few of the file's other forms.
+// Usage: fogcl_make_seeds EXR_DIR [JSON_DIR]
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "cli/volumes_cli.h"
 #include "exr_fixtures.h"
+#include "fogcl/demo_scene.h"
+
+namespace {
+
+void write_json_seeds(const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const auto put = [&](const std::string& name, const std::string& text) { std::ofstream(dir + "/" + name) << text; };
+  put("volumes.json", fogcl::cli::volumes_to_json(fogcl::demo_fog_volumes(fogcl::VolumeIntegrator::stylized)));
+  put("volumes-physical.json", fogcl::cli::volumes_to_json(fogcl::demo_fog_volumes(fogcl::VolumeIntegrator::physical)));
+  put("minimal.json", R"({"volumes": [{"center": [0, 1, 0], "radius": 2}]})");
+  put("homogeneous.json", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "medium": "homogeneous", "albedo": [0.5, 0.5, 0.5]}]})");
+  put("empty.json", R"({"volumes": []})");
+  std::printf("wrote 5 seed files to %s\n", dir.c_str());
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace fogcl::fixtures;
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: %s DIR\n", argv[0]);
+  if (argc != 2 && argc != 3) {
+    std::fprintf(stderr, "usage: %s EXR_DIR [JSON_DIR]\n", argv[0]);
     return 2;
   }
+  if (argc == 3) write_json_seeds(argv[2]);
   const std::string dir = argv[1];
   std::filesystem::create_directories(dir);
   const auto box = [](int x0, int y0, int x1, int y1) { return Imath::Box2i(Imath::V2i(x0, y0), Imath::V2i(x1, y1)); };

@@ -26,6 +26,7 @@
 
 #include "cli/cli.h"
 #include "cli/file_checks.h"
+#include "cli/frame_memory.h"
 #include "cli/frame_pipeline.h"
 #include "cli/sequence.h"
 #include "cli/volumes_cli.h"
@@ -177,6 +178,10 @@ void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullp
     request.color_into = &spare->color;
     request.depth_into = &spare->depth;
   }
+  // What the frame will need is checked from its header, before anything is allocated.
+  const FrameMemoryNeeds needs = frame_memory_needs(o);
+  const MemoryLimit limit = memory_limit(o.max_memory);
+  request.before_allocating = [&](const ExrFrameShape& shape) { check_frame_memory(paths.color, shape, needs, limit); };
   job.color = read_exr(paths.color, request);
   const ExrInput& color = job.color;
 
@@ -195,10 +200,13 @@ void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullp
     depth_request.depth_single_channel_fallback = true;
     depth_request.depth_outside = outside;
     if (spare != nullptr) depth_request.depth_into = &spare->depth;
+    // Before its frame is allocated: a depth file describing another (larger) frame costs nothing.
+    depth_request.before_allocating = [&](const ExrFrameShape& shape) {
+      if (!(shape.windows == color.windows))
+        throw Error(paths.depth + ": data/display window differs from " + paths.color +
+                    "'s: depth and color must cover the same pixels");
+    };
     ExrInput d = read_exr(paths.depth, depth_request);
-    if (!(d.windows == color.windows))
-      throw Error(paths.depth + ": data/display window differs from " + paths.color +
-                  "'s: depth and color must cover the same pixels");
     job.depth = std::move(d.depth);
   }
   to_raw_depth(job.depth, kind, job.params);
@@ -313,6 +321,10 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
                int sequence_frame) {
   const ExrInput& color = job.color;
   const CameraParams& params = job.params;
+  // A clear line where the OpenCL call would fail with CL_INVALID_BUFFER_SIZE.
+  if (backend.runtime() != nullptr)
+    check_device_allocations(job.paths.color, *backend.runtime(), color.color.width(), color.color.height(),
+                             color.color.format(), frame_memory_needs(o));
   std::string precision_why;
   const FogSettings settings = pass_settings(o, backend, color.color.format(), &precision_why);
   if (print_setup) {
@@ -434,6 +446,7 @@ int sweep_stale_temporaries(const FramePattern& pattern) {
 
 int run_apply(const ApplyOptions& o) {
   parse_depth_kind(o.depth_kind);  // a bad kind fails before any file is touched
+  memory_limit(o.max_memory);      // so does a bad --max-memory
   if (o.fov != 0.0f && o.ortho_size != 0.0f)
     throw Error("give either --fov (perspective) or --ortho-size (orthographic), not both");
   if (o.ortho_size != 0.0f && o.infinite_far)
@@ -481,8 +494,21 @@ int run_apply(const ApplyOptions& o) {
     throw Error("--out '" + o.out_path + "' needs a frame placeholder (#### or %04d) when --color is a sequence");
   if (!o.png_path.empty() && !png.is_sequence)
     throw Error("--png '" + o.png_path + "' needs a frame placeholder (#### or %04d) when --color is a sequence");
-  const std::vector<int> frames = o.frames.empty() ? frames_on_disk(color) : parse_frame_range(o.frames);
+  // The frames on disk (within --frames); those missing from the range, or from the run of frames
+  // on disk, fail the run as ranges, before any frame is read (--keep-going: the others are fogged).
+  const SequenceFrames found =
+      find_sequence_frames(color, o.frames.empty() ? std::nullopt : std::optional(parse_frame_range(o.frames)));
+  const std::vector<int>& frames = found.present;
+  const std::string missing = found.missing.empty() ? std::string()
+                              : "missing frames " + ranges_text(found.missing) + " (" +
+                                    std::to_string(found.missing_count) + " of " + std::to_string(found.requested) +
+                                    " frames: no such files)";
+  if (!missing.empty() && (!o.keep_going || frames.empty()))
+    throw Error("'" + o.color_path + "': " + missing + (frames.empty() ? "" : "; --keep-going fogs the others"));
   if (frames.empty()) throw Error("'" + o.color_path + "': no frames found (give --frames FIRST-LAST)");
+  if (!missing.empty())
+    std::fprintf(stderr, "fogcl: '%s': %s; fogging the other %zu\n", o.color_path.c_str(), missing.c_str(),
+                 frames.size());
 
   // The files every frame reads (each frame's own are checked as it is read).
   check_files({{"--depth", depth.is_sequence ? "" : o.depth_path}, {"--volumes", o.volumes.volumes_path},
@@ -644,8 +670,10 @@ int run_apply(const ApplyOptions& o) {
                  frames.size(), last_written >= 0 ? (" (the last: frame " + std::to_string(last_written) + ")").c_str() : "");
     return 128 + g_interrupt.load();
   }
-  if (!failures.empty()) {
-    std::fprintf(stderr, "fogcl: error: %zu of %zu frames failed:\n", failures.size(), frames.size());
+  if (!failures.empty() || !missing.empty()) {
+    std::fprintf(stderr, "fogcl: error: %lld of %lld frames failed:\n", (long long)failures.size() + found.missing_count,
+                 found.requested);
+    if (!missing.empty()) std::fprintf(stderr, "  %s\n", missing.c_str());
     for (const std::string& f : failures) std::fprintf(stderr, "  %s\n", f.c_str());
     return 1;
   }

@@ -48,6 +48,7 @@ struct ApplyOptions {
   bool rgba_only = false;          // output only R, G, B, A (no other channels, parts, attributes)
   std::string frames;              // "FIRST-LAST" for sequences; "" = the frames on disk
   bool keep_going = false;         // sequences: continue past a bad frame
+  std::string max_memory;          // --max-memory: "" = half of the machine's memory (cli/frame_memory.h)
   int threads = 0;                 // OpenEXR's (de)compression threads (and PoCL's); 0 = every core
   std::string pixel_type = "float";  // of the fogged R, G, B, A: float | half
   std::string compression;         // of the output's color part; "" = the input's

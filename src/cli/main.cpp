@@ -69,6 +69,9 @@ int main(int argc, char** argv) {
   apply_cmd->add_option("--frames", ap.frames, "Sequences: FIRST-LAST (default: the frames found on disk)");
   apply_cmd->add_flag("--keep-going", ap.keep_going,
                       "Sequences: continue past a bad frame, list the failures at the end (exit code still 1)");
+  apply_cmd->add_option("--max-memory", ap.max_memory,
+                        "Refuse a frame whose header says it needs more memory than this (color, depth, output, "
+                        "volume buffers), e.g. 8G or 512M (binary units; default: half of the machine's memory)");
   apply_cmd->add_option("--threads", ap.threads,
                         "Threads that compress and decompress EXR data (OpenEXR's pool) and run PoCL's "
                         "device, 1 to 4096 (default: every core this process may use)")

@@ -77,7 +77,15 @@ std::vector<int> frames_on_disk(const FramePattern& p) {
   std::string stem = probe.filename().string();
   stem.pop_back();
   std::error_code ec;
-  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+  const auto cannot_list = [&] {
+    return Error("'" + p.text + "': cannot list the folder '" + dir.string() + "' to find its frames: " + ec.message());
+  };
+  fs::directory_iterator it(dir, ec), end;
+  if (ec) {
+    if (ec == std::errc::no_such_file_or_directory || ec == std::errc::not_a_directory) return frames;
+    throw cannot_list();
+  }
+  for (; it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     if (name.size() <= stem.size() + p.suffix.size() || name.compare(0, stem.size(), stem) != 0 ||
         name.compare(name.size() - p.suffix.size(), p.suffix.size(), p.suffix) != 0)
@@ -87,11 +95,12 @@ std::vector<int> frames_on_disk(const FramePattern& p) {
     const int frame = std::stoi(digits);
     if (fs::path(frame_path(p, frame)).filename().string() == name) frames.push_back(frame);
   }
+  if (ec) throw cannot_list();
   std::sort(frames.begin(), frames.end());
   return frames;
 }
 
-std::vector<int> parse_frame_range(const std::string& text) {
+FrameRange parse_frame_range(const std::string& text) {
   const auto bad = [&] {
     return Error("--frames must be FRAME or FIRST-LAST with 0 <= FIRST <= LAST < 10^9 (got '" + text + "')");
   };
@@ -101,9 +110,46 @@ std::vector<int> parse_frame_range(const std::string& text) {
     if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), is_digit)) throw bad();
   const int first = std::stoi(a), last = std::stoi(b);
   if (first > last) throw bad();
-  std::vector<int> frames;
-  for (int f = first; f <= last; ++f) frames.push_back(f);
-  return frames;
+  return FrameRange{first, last};
+}
+
+SequenceFrames find_sequence_frames(const FramePattern& pattern, const std::optional<FrameRange>& wanted) {
+  SequenceFrames out;
+  std::vector<int> on_disk = frames_on_disk(pattern);
+  if (wanted) {
+    for (int f : on_disk)
+      if (f >= wanted->first && f <= wanted->last) out.present.push_back(f);
+  } else {
+    out.present = std::move(on_disk);
+  }
+  const FrameRange span = wanted                  ? *wanted
+                          : out.present.empty()   ? FrameRange{}
+                                                  : FrameRange{out.present.front(), out.present.back()};
+  out.requested = span.count();
+  // The holes of `span` around the present frames (ascending, so one pass).
+  long long next = span.first;  // the first frame not yet accounted for
+  const auto hole_until = [&](long long end) {  // frames next..end-1 are missing
+    if (end > next) {
+      out.missing.push_back({int(next), int(end - 1)});
+      out.missing_count += end - next;
+    }
+  };
+  for (int f : out.present) {
+    hole_until(f);
+    next = (long long)f + 1;
+  }
+  if (span.count() > 0) hole_until((long long)span.last + 1);
+  return out;
+}
+
+std::string ranges_text(const std::vector<FrameRange>& ranges, std::size_t max_ranges) {
+  std::string out;
+  for (std::size_t i = 0; i < ranges.size() && i < max_ranges; ++i) {
+    const FrameRange& r = ranges[i];
+    out += (i > 0 ? ", " : "") + std::to_string(r.first) + (r.last > r.first ? "-" + std::to_string(r.last) : "");
+  }
+  if (ranges.size() > max_ranges) out += ", ... (" + std::to_string(ranges.size() - max_ranges) + " more ranges)";
+  return out;
 }
 
 ProgressBar::ProgressBar(int total, bool enabled)

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <chrono>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,9 +22,32 @@ FramePattern parse_frame_pattern(const std::string& path);
 // The path of `frame` (>= 0); the pattern's text itself when it is not a sequence.
 std::string frame_path(const FramePattern& pattern, int frame);
 // Frames whose files exist, ascending (a name counts when frame_path() gives it back exactly).
+// A folder that does not exist has none; one that cannot be listed throws fogcl::Error.
 std::vector<int> frames_on_disk(const FramePattern& pattern);
-// "12" or "1-48" (inclusive, first <= last, both >= 0); throws fogcl::Error naming the text.
-std::vector<int> parse_frame_range(const std::string& text);
+
+// Frames first..last, inclusive.
+struct FrameRange {
+  int first = 0, last = -1;
+  long long count() const { return last < first ? 0 : (long long)last - first + 1; }
+};
+// "12" or "1-48" (inclusive, 0 <= first <= last < 10^9); throws fogcl::Error naming the text.
+FrameRange parse_frame_range(const std::string& text);
+
+// The frames of a sequence: those whose files exist within `wanted` (--frames), and the rest of
+// `wanted` as missing ranges; without `wanted`, the frames on disk and the gaps between the first
+// and the last of them. One listing of the folder: nothing is spent per absent frame, however
+// large the range (--frames 1-999999999 costs what the folder's files cost).
+struct SequenceFrames {
+  std::vector<int> present;         // ascending
+  std::vector<FrameRange> missing;  // ascending, disjoint, not adjacent
+  long long missing_count = 0;      // frames in `missing`
+  long long requested = 0;          // present + missing
+};
+SequenceFrames find_sequence_frames(const FramePattern& pattern, const std::optional<FrameRange>& wanted);
+
+// "3, 7-9, 1001-999999999": at most `max_ranges` ranges, then ", ... (N more ranges)", so that a
+// sequence with every other frame missing still gives one short line.
+std::string ranges_text(const std::vector<FrameRange>& ranges, std::size_t max_ranges = 8);
 
 // The text of the progress bar: "[=====     ] 12/48 frames  3.10 frames/s  ETA 0:12". With frames
 // in flight the first frame finishes after a whole pipeline's latency and the next ones one

@@ -206,9 +206,45 @@ struct ParseContext {
   }
 };
 
+// Deeper nesting than this is refused before parsing: nlohmann's parser and the code that prints
+// a value (shown()) recurse once per level, so 100 000 '[' overflowed the stack. A volumes file
+// nests 4 levels (the top object, "volumes", a volume, a vector); 64 leaves room for any mistake
+// worth a specific message.
+constexpr int kMaxJsonDepth = 64;
+
+// Throws "NAME: JSON nested deeper than 64 levels at line L, column C ..." for text whose arrays
+// and objects nest deeper than kMaxJsonDepth (outside strings); leaves every other error to the parser.
+void check_json_depth(const std::string& text, const std::string& name) {
+  int depth = 0;
+  long line = 1, column = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    ++column;
+    if (c == '\n') line += 1, column = 0;
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error(name + ": JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels at line " +
+                    std::to_string(line) + ", column " + std::to_string(column) +
+                    " (a volumes file needs 4: {\"volumes\": [{\"center\": [x, y, z]}]})");
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name) {
+  check_json_depth(text, name);
   ParseContext ctx;
   // Depths as nlohmann counts them: the top object 0, its keys 1, volume objects 2, their keys 3.
   const json::parser_callback_t track = [&ctx](int depth, json::parse_event_t event, json& parsed) {

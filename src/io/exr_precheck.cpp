@@ -1,6 +1,9 @@
 #include "io/exr_precheck.h"
 
+#include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "fogcl/error.h"
@@ -24,6 +27,44 @@ int lines_per_chunk(int compression) {
     case 9: return 256;                 // DWAB
     default: return 1;
   }
+}
+
+// The most bytes of pixels one stored byte can decode to, per compression: a header whose pixels
+// could not fit in the file even so is refused before anything is allocated for them. Upper bounds
+// of each decoder, with margin (the OpenEXR file layout; ImfRle.cpp, ImfHuf.cpp, ImfDwaCompressor.cpp):
+//   NONE   1      the pixels as they are
+//   RLE    64     a run of up to 128 equal bytes in 2
+//   ZIPS,  1032   deflate's limit: a 258-byte match in 2 bits (zlib's FAQ)
+//   ZIP
+//   PIZ    512    Huffman with run codes: up to 255 repeats of a 16-bit value in 9 bits (453)
+//   PXR24  1376   deflate of floats cut to 24 bits: 1032 * 4 / 3
+//   B44,   32/3   a flat 4x4 block of half values (32 bytes) in 3; other types are stored raw
+//   B44A
+//   DWAA,  66048  one DC value per 8x8 block, deflated: 64 * 1032 (the other streams expand less)
+//   DWAB
+// 0 = unknown (no bound; OpenEXR refuses a compression it does not know).
+double max_expansion(int compression) {
+  switch (compression) {
+    case 0: return 1;
+    case 1: return 64;
+    case 2: case 3: return 1032;
+    case 4: return 512;
+    case 5: return 1376;
+    case 6: case 7: return 32.0 / 3.0;
+    case 8: case 9: return 66048;
+    default: return 0;
+  }
+}
+
+const char* compression_name(int compression) {
+  static const char* const names[] = {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"};
+  return compression >= 0 && compression < 10 ? names[compression] : "unknown";
+}
+
+std::string bytes_text(double bytes) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.0f", bytes);
+  return buf;
 }
 
 // Value sizes of the fixed-size attribute types (OpenEXR file layout, "Attribute types"). OpenEXR
@@ -71,10 +112,20 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
     }
   };
   std::uint64_t chunks_total = 0;
+  // The least the file must hold after its headers and offset tables: each part's chunk headers
+  // and its pixels as compressed as its compression could make them (max_expansion).
+  double least_bytes = 0;
+  std::string largest_claim;  // the part whose pixels need the most bytes, for the message
+  double largest_least = -1;
   for (int part = 0;; ++part) {
-    bool tiled = tiled_single, have_data = false;
+    bool tiled = tiled_single, deep = false, have_data = false;
     std::int64_t data_w = 0, data_h = 0, chunk_count = -1;
+    std::int32_t data_box[4] = {0, 0, -1, -1};
     int compression = 0, tile_w = 0, tile_h = 0;
+    struct ChannelSize {
+      int bytes, x_sampling, y_sampling;
+    };
+    std::vector<ChannelSize> channels;
     std::string attr, type;
     for (;;) {
       read_name(attr);
@@ -92,12 +143,17 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
       if (type == "chlist") {
         // OpenEXR reads a channel list up to its empty name, whatever the stated size says, and
         // goes on from there: follow it the same way so both walks stay in step.
+        // Each channel: pixel type (0 UINT, 1 HALF, 2 FLOAT), pLinear, 3 reserved bytes, x and y sampling.
         std::string channel;
         char fields[16];
         for (;;) {
           read_name(channel);
           if (channel.empty()) break;
           get(16, fields);
+          const std::int32_t pixel_type = le32(fields);
+          if (attr == "channels")
+            channels.push_back({pixel_type == 1 ? 2 : pixel_type == 0 || pixel_type == 2 ? 4 : 0, le32(fields + 8),
+                                le32(fields + 12)});
         }
         continue;
       }
@@ -129,7 +185,10 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
         if (w > 0 && h > 0 && w > max_pixels / h)  // w * h may not fit in 64 bits (found by the fuzzer)
           throw fail(attr + " is " + std::to_string(w) + "x" + std::to_string(h) + " pixels, more than the limit of " +
                      (max_pixels == (std::int64_t(1) << 31) ? std::string("2^31") : std::to_string(max_pixels)));
-        if (attr == "dataWindow") have_data = w > 0 && h > 0, data_w = w, data_h = h;
+        if (attr == "dataWindow") {
+          have_data = w > 0 && h > 0, data_w = w, data_h = h;
+          for (int i = 0; i < 4; ++i) data_box[i] = le32(&value[std::size_t(4 * i)]);
+        }
       } else if (type == "compression" && size == 1) {
         compression = std::uint8_t(value[0]);
       } else if (type == "tiledesc" && size == 9) {
@@ -143,6 +202,7 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
       } else if (attr == "type" && size < 64) {
         const std::string t(value.begin(), value.end());
         tiled = t == "tiledimage" || t == "deeptile";
+        deep = t == "deepscanline" || t == "deeptile";
       }
     }
     // A lower bound of the chunks: the chunk count if stated, else level 0's chunks.
@@ -159,12 +219,48 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
     if (chunks_total > file_size / 8)
       throw fail("the headers announce " + std::to_string(chunks_total) + " chunks, whose offset table alone is larger than the " +
                  std::to_string(file_size) + "-byte file (truncated or corrupt)");
-    if (!multipart) return;
-    char next = 0;
-    get(1, &next);  // an empty name ends the header list
-    if (next == 0) return;
-    --pos;
+    // Level 0's pixels (a deep part: its sample count table, 4 bytes a pixel; it may hold no samples).
+    double pixel_bytes = 0;
+    if (have_data) {
+      if (deep) {
+        pixel_bytes = 4.0 * double(data_w) * double(data_h);
+      } else {
+        for (const ChannelSize& c : channels)
+          if (c.x_sampling > 0 && c.y_sampling > 0)
+            pixel_bytes += double(c.bytes) * double(data_w / c.x_sampling) * double(data_h / c.y_sampling);
+      }
+    }
+    // A chunk starts with its coordinates and sizes: y and size (scan lines), 4 tile coordinates
+    // and size (tiles); deep chunks state three 8-byte sizes instead of one; and a part number in
+    // multi-part files.
+    const int chunk_header = (tiled ? 16 : 4) + (deep ? 24 : 4) + (multipart ? 4 : 0);
+    const double expansion = max_expansion(compression);
+    const double least = double(chunks) * chunk_header + (expansion > 0 ? pixel_bytes / expansion : 0.0);
+    least_bytes += least;
+    if (least > largest_least) {
+      largest_least = least;
+      largest_claim = std::string(multipart ? "part " + std::to_string(part) + ": " : "") + "dataWindow (" +
+                      std::to_string(data_box[0]) + ", " + std::to_string(data_box[1]) + ")-(" +
+                      std::to_string(data_box[2]) + ", " + std::to_string(data_box[3]) + ") holds " +
+                      bytes_text(pixel_bytes) + " bytes of " + (deep ? "deep sample counts" : "pixels") + "; " +
+                      compression_name(compression) + " compression and " + std::to_string(chunks) +
+                      " chunks store that in no fewer than " + bytes_text(std::ceil(least)) + " bytes";
+    }
+    if (multipart) {
+      char next = 0;
+      get(1, &next);  // an empty name ends the header list
+      if (next != 0) {
+        --pos;
+        continue;
+      }
+    }
+    break;
   }
+  // pos is the end of the headers; the offset tables (8 bytes a chunk) follow, then the chunks.
+  const double after_headers = double(file_size - pos) - 8.0 * double(chunks_total);
+  if (least_bytes > after_headers)
+    throw fail(largest_claim + ", but the file has " + bytes_text(after_headers) +
+               " bytes after its headers and offset tables (truncated or corrupt)");
 }
 
 }  // namespace fogcl::detail

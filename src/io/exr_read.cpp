@@ -329,12 +329,34 @@ int find_part(const Source& s, const std::vector<std::string>& channels, int pre
   return -1;
 }
 
+// The storage of the color frame: half when asked for and every color channel of a flat part is HALF.
+ColorFormat color_storage(const Source& s, int part, const std::string& prefix, const ExrReadRequest& r) {
+  const Imf::Header& h = s.file->header(part);
+  bool all_half = !is_deep(h);
+  for (const char* c : {"R", "G", "B", "A"})
+    if (const Imf::Channel* channel = h.channels().findChannel(prefix + c)) all_half = all_half && channel->type == Imf::HALF;
+  return r.keep_half && all_half ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+}
+
 ExrInput read_source(Source& s, const ExrReadRequest& r) {
   ExrInput out;
   out.path = s.path;
   out.parts = s.file->parts();
   out.layer = r.layer;
   const std::string prefix = r.layer.empty() ? "" : r.layer + ".";
+  // Once, before the first frame is allocated (the depth's when it comes first).
+  bool announced = false;
+  const auto before_allocating = [&](const Frame& f) {
+    if (announced || !r.before_allocating) return;
+    announced = true;
+    ExrFrameShape shape;
+    shape.windows = detail::to_windows(f.display, f.data);
+    shape.color = r.read_color;
+    if (r.read_color) shape.color_format = color_storage(s, out.color_part, prefix, r);
+    for (const int part : {out.color_part, out.depth_part})
+      if (part >= 0) shape.deep = shape.deep || is_deep(s.file->header(part));
+    r.before_allocating(shape);
+  };
 
   if (r.read_color) {
     const std::vector<std::string> rgb{prefix + "R", prefix + "G", prefix + "B"};
@@ -382,6 +404,7 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
                     box_string(dh.displayWindow()) + ", data " + box_string(dh.dataWindow()) +
                     ") differ from the color part's: depth and color must cover the same pixels");
     }
+    before_allocating(df);
     out.depth = depth_frame(r.depth_into, df, r.depth_outside, read_leaves_gaps(df, is_deep(dh)));
     if (is_deep(dh))
       read_deep(s, out.depth_part, df, r, prefix, nullptr, out.depth.data(), name);
@@ -404,10 +427,8 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
   const Frame f = frame_of(s, out.color_part, r, &out.windows);
   out.camera = camera_of(ch);
   out.compression = int(ch.compression());
-  bool all_half = !is_deep(ch);
-  for (const char* c : {"R", "G", "B", "A"})
-    if (const Imf::Channel* channel = ch.channels().findChannel(prefix + c)) all_half = all_half && channel->type == Imf::HALF;
-  const bool half = r.keep_half && all_half;
+  const bool half = color_storage(s, out.color_part, prefix, r) == ColorFormat::rgba16f;
+  before_allocating(f);
   out.color = color_frame(r.color_into, f, half ? ColorFormat::rgba16f : ColorFormat::rgba32f,
                           read_leaves_gaps(f, is_deep(ch)));
   if (is_deep(ch)) {

@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include <glm/vec2.hpp>
@@ -33,6 +34,14 @@ struct ExrWindows {
 //    the depth is the nearest sample's; a pixel without samples is (0, 0, 0, 0) and background.
 //    Deep tiled parts are rejected.
 
+// What a read is about to allocate, told to ExrReadRequest::before_allocating.
+struct ExrFrameShape {
+  ExrWindows windows;         // the frame's: the display window is its size
+  ColorFormat color_format = ColorFormat::rgba32f;  // the color frame's storage (when color is read)
+  bool color = true;          // a color frame is read (false: depth only)
+  bool deep = false;          // a deep part is flattened (its pixel tables need memory of their own)
+};
+
 struct ExrReadRequest {
   std::string layer;                 // "" = R, G, B, A; "beauty" = beauty.R, beauty.G, ...
   bool read_color = true;            // false: depth only (a --depth file)
@@ -48,6 +57,9 @@ struct ExrReadRequest {
   DepthImage* depth_into = nullptr;
   std::int64_t max_pixels = std::int64_t(1) << 31;   // per frame (display window); more is corrupt
   std::int64_t max_deep_samples = std::int64_t(1) << 28;  // per deep part
+  // Called once the header is read and the windows are checked, before any pixel memory is
+  // allocated; may throw to refuse the frame (fogcl apply's --max-memory). Empty: not called.
+  std::function<void(const ExrFrameShape&)> before_allocating;
 };
 
 // A perspective camera read from the standard attributes worldToNDC and worldToCamera (OpenEXR's
