@@ -29,7 +29,7 @@ const char* kDeviceHelp =
 
 int main(int argc, char** argv) {
   fogcl::detail::remove_temporaries_on_signals();  // a killed run leaves no temporary file
-  CLI::App app{"fogcl: deferred fog (Unity linear/exp/exp2) on OpenCL devices and in C++"};
+  CLI::App app{"fogcl: deferred fog (Unity linear/exp/exp2) and volumetric fog volumes, on OpenCL devices and in C++"};
   app.require_subcommand(1);
   app.footer(fogcl::cli::exit_codes_help());
 
