@@ -46,8 +46,8 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
         if constexpr (kDistance) {
           ray = fog_corner_ray_term(c, fog_pixel_u(float(x), inv_width), vv, FOG_SQUARED(kMode, kDistance));
         }
-        f[x] = fog_factor(d[x], ray, kMode, kDistance, kSkybox, kReversed, projection, zx, zy, near_plane,
-                          far_plane, k.a, k.b);
+        f[x] = fog_factor(d[x], ray, FOG_DEPTH_RAW, kMode, kDistance, kSkybox, /*sky_infinite=*/0, kReversed,
+                          projection, zx, zy, near_plane, far_plane, k.a, k.b);
       }
       const Channel* ci = in + 4 * std::size_t(y) * std::size_t(w);
       Channel* co = out + 4 * std::size_t(y) * std::size_t(w);

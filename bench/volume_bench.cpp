@@ -168,7 +168,7 @@ double march_work(const DemoFrame& f, const VolumeScene& s, const VolumeSettings
   for (int ly = 0; ly < p.low_height; ++ly)
     for (int lx = 0; lx < p.low_width; ++lx) {
       const float eye = vol_block_eye_depth<float>(f.depth.data(), lx, ly, scale, f.color.width(), f.color.height(),
-                                                   int(v.projection), v.reversed_z, fr[VOL_F_ZX], fr[VOL_F_ZY],
+                                                   int(v.projection), v.reversed_z, int(v.depth_kind), fr[VOL_F_ZX], fr[VOL_F_ZY],
                                                    fr[VOL_F_NEAR], fr[VOL_F_FAR]);
       glm::vec3 origin, dir;
       float t_per_eye;

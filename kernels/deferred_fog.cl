@@ -6,6 +6,10 @@
  *   FOG_DISTANCE      distance-based fog (corner interpolation, and a sqrt but for exp2); else
  *                     depth-based
  *   FOG_SKYBOX        fog the skybox too (no sky test); else sky pixels keep f = 1
+ *   FOG_DEPTH_KIND    what the depth buffer holds: 0 raw device depth (default), 1 linear eye
+ *                     depth, 2 radial distance (fog_view_distance_linear: never through raw depth;
+ *                     the corners are then the rays at view z = 1)
+ *   FOG_SKY_INFINITE  the sky is infinitely far: fully fogged in every mode (with FOG_SKYBOX)
  *   REVERSED_Z        depth 1 at near, 0 at far (decides where a NaN depth lands: the far end)
  *   FOG_PROJECTION    0 perspective (default), 1 reversed-Z infinite far, 2 orthographic
  *   FOG_COLOR_HALF    color stored as RGBA half; else RGBA float
@@ -54,6 +58,14 @@
 #ifndef FOG_PROJECTION
 #define FOG_PROJECTION 0
 #endif
+#ifndef FOG_DEPTH_KIND
+#define FOG_DEPTH_KIND 0
+#endif
+#ifdef FOG_SKY_INFINITE
+#define FOG_USE_SKY_INFINITE 1
+#else
+#define FOG_USE_SKY_INFINITE 0
+#endif
 #ifdef REVERSED_Z
 #define FOG_USE_REVERSED_Z 1
 #else
@@ -66,8 +78,9 @@
 #if FOG_VECTOR_WIDTH == 16
 #define FOG_CLAMP_BY_SELECT /* CPU devices: LLVM keeps IEEE comparisons (fog_sanitize_depth) */
 #endif
-/* What the ray term is: |ray|, or |ray|^2 for distance-based exp2 (fog_math.h, FOG_SQUARED). */
-#define FOG_USE_SQUARED FOG_SQUARED(FOG_MODE, FOG_USE_DISTANCE)
+/* Whether the pixel's ray is read, and whether its term is |ray|^2 (fog_math.h, FOG_RAY_SQUARED). */
+#define FOG_USE_RAY FOG_NEEDS_RAY(FOG_USE_DISTANCE, FOG_DEPTH_KIND)
+#define FOG_USE_SQUARED FOG_RAY_SQUARED(FOG_MODE, FOG_USE_DISTANCE, FOG_DEPTH_KIND)
 
 #include "fog_math.h" /* the one-pixel instance */
 
@@ -122,14 +135,14 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
                              global COLOR_T* color_out, size_t i, int x, int y,
                              const FogConstants* k) {
   float ray = 0.0f;
-#if FOG_USE_DISTANCE
+#if FOG_USE_RAY
   const float u = fog_pixel_u((float)x, k->inv_width), v = fog_pixel_v((float)y, k->height);
   ray = fog_ray_term(fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v),
                      fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
                      fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v), FOG_USE_SQUARED);
 #endif
-  const float f = fog_factor(depth[i], ray, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
-                             FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx, k->zy, k->near_plane, k->far_plane,
+  const float f = fog_factor(depth[i], ray, FOG_DEPTH_KIND, FOG_MODE, FOG_USE_DISTANCE, FOG_USE_SKYBOX,
+                             FOG_USE_SKY_INFINITE, FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx, k->zy, k->near_plane, k->far_plane,
                              k->k_a, k->k_b);
   fog_blend_pixel(color_in, color_out, i, f, k);
 }

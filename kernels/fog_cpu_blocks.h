@@ -73,7 +73,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
                                 global COLOR_T* color_out, size_t i0, int x0, int y,
                                 const FogConstants* k) {
   float16 ray = 0.0f;
-#if FOG_USE_DISTANCE
+#if FOG_USE_RAY
   const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   const float16 u = fog_pixel_u_v((float16)((float)x0) + lane, (float16)k->inv_width);
   const float16 v = (float16)fog_pixel_v((float)y, k->height);
@@ -83,8 +83,8 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
       fog_bilerp_v((float16)k->bl.z, (float16)k->br.z, (float16)k->tl.z, (float16)k->tr.z, u, v),
       FOG_USE_SQUARED);
 #endif
-  const float16 f = fog_factor_v(vload16(0, depth + i0), ray, FOG_MODE, FOG_USE_DISTANCE,
-                                 FOG_USE_SKYBOX, FOG_USE_REVERSED_Z, FOG_PROJECTION, (float16)k->zx,
+  const float16 f = fog_factor_v(vload16(0, depth + i0), ray, FOG_DEPTH_KIND, FOG_MODE, FOG_USE_DISTANCE,
+                                 FOG_USE_SKYBOX, FOG_USE_SKY_INFINITE, FOG_USE_REVERSED_Z, FOG_PROJECTION, (float16)k->zx,
                                  (float16)k->zy, (float16)k->near_plane, (float16)k->far_plane,
                                  (float16)k->k_a, (float16)k->k_b);
   global const COLOR_T* in = color_in + 4 * i0;

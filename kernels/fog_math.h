@@ -53,6 +53,10 @@
 #define FOG_PROJECTION_PERSPECTIVE 0
 #define FOG_PROJECTION_INFINITE_FAR 1
 #define FOG_PROJECTION_ORTHOGRAPHIC 2
+/* What the depth buffer holds (FOG_DEPTH_KIND in the kernel, DepthKind on the host). */
+#define FOG_DEPTH_RAW 0
+#define FOG_DEPTH_EYE 1
+#define FOG_DEPTH_DISTANCE 2
 /* Distance-based exp2 fog works on the squared view distance q = d^2, which it needs anyway, so
  * it takes no square root of |ray|^2 (a vector sqrt costs the CPU path about 4 cycles per 16
  * pixels). Everything else works on q = d. */
@@ -224,15 +228,55 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_exp2)(FOG_REAL q, FOG_REAL k, int squared) {
   return FOG_EXP2(fma(-t, t, (FOG_REAL)0)); /* -(t * t) in one fused negative multiply */
 }
 
+/* Linear depth clamped as raw depth's clamp to [0, 1] clamps eye depth: into [lo, hi] (eye depth:
+ * [near, far]; radial distance: the same along the pixel's ray). NaN, <= 0 (nothing written) and
+ * from 0.9999 hi on (the raw path's sky test; +inf, and every value of an infinite far plane's
+ * hi = +inf) are sky, at hi. */
+FOG_FN FOG_REAL FOG_NAME(fog_clamp_linear_depth)(FOG_REAL value, FOG_REAL lo, FOG_REAL hi, FOG_INT* sky) {
+  FOG_INT none = FOG_IS_NAN(value) | (value <= (FOG_REAL)0);
+  FOG_REAL clamped = fmin(fmax(value, lo), hi);
+  clamped = none ? hi : clamped;
+  *sky = clamped >= (FOG_REAL)0.9999f * hi;
+  return clamped;
+}
+
+/* The distance q of docs/DESIGN.md §2 from linear depth (FOG_DEPTH_EYE: eye depth along the view
+ * axis; FOG_DEPTH_DISTANCE: radial distance from the eye), as the renderer wrote it: never through
+ * raw depth, whose float holds eye depth only to about eye / near ulps (near 1e-6, eye 1000:
+ * no digit left). ray = |ray1| of the pixel's ray at view z = 1 (the host passes unit corners),
+ * or |ray1|^2 where eye depth meets `squared`; read where `distance` or for radial distance. */
+FOG_FN FOG_REAL FOG_NAME(fog_view_distance_linear)(FOG_REAL value, FOG_REAL ray, int kind, int distance,
+                                                   int squared, FOG_REAL near_plane, FOG_REAL far_plane,
+                                                   FOG_INT* sky) {
+  if (kind == FOG_DEPTH_DISTANCE) {
+    if (distance) { /* the radial distance is the fog's distance: no division, no rounding */
+      FOG_REAL r = FOG_NAME(fog_clamp_linear_depth)(value, near_plane * ray, far_plane * ray, sky);
+      return squared ? r * r : r;
+    }
+    return FOG_NAME(fog_clamp_linear_depth)(value / ray, near_plane, far_plane, sky) - near_plane;
+  }
+  FOG_REAL e = FOG_NAME(fog_clamp_linear_depth)(value, near_plane, far_plane, sky);
+  if (distance) return squared ? (e * e) * ray : e * ray;
+  return e - near_plane;
+}
+
+/* Whether the ray term is |ray|^2: distance-based exp2 (FOG_SQUARED) on raw or eye depth; radial
+ * distance needs |ray1| itself to bound the distance. Whether a variant reads the ray at all:
+ * distance-based, or radial distance. */
+#define FOG_RAY_SQUARED(mode, distance, kind) (FOG_SQUARED(mode, distance) && (kind) != FOG_DEPTH_DISTANCE)
+#define FOG_NEEDS_RAY(distance, kind) ((distance) || (kind) == FOG_DEPTH_DISTANCE)
+
 /* The distance of docs/DESIGN.md §2 from a raw depth, and whether the pixel is sky: q = d, or d^2
  * where `squared` (FOG_SQUARED: distance-based exp2). The int parameters are compile-time
  * constants in the kernel, so the branches a variant does not use fold away. ray = fog_ray_term
  * (|ray(u, v)|, or its square) is read only when distance-based (perspective only: with parallel
  * orthographic rays the host folds distance into depth). */
-FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray, int distance,
+FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray, int kind, int distance,
                                             int reversed_z, int projection, int squared,
                                             FOG_REAL zx, FOG_REAL zy, FOG_REAL near_plane,
                                             FOG_REAL far_plane, FOG_INT* sky) {
+  if (kind != FOG_DEPTH_RAW)
+    return FOG_NAME(fog_view_distance_linear)(raw, ray, kind, distance, squared, near_plane, far_plane, sky);
   FOG_REAL depth = FOG_NAME(fog_sanitize_depth)(raw, reversed_z);
   /* scale * |ray| is the distance-based d; the depth-based d has no ray. */
   FOG_REAL scale, d;
@@ -254,13 +298,15 @@ FOG_FN FOG_REAL FOG_NAME(fog_view_distance)(FOG_REAL raw, FOG_REAL ray, int dist
 
 /* The fog factor f at view distance q (fog_view_distance: d, or d^2 where squared; it also says
  * whether the pixel is sky). k_a, k_b: linear (end, 1 / (end - start)); step (start); exp and exp2 (k,
- * density). */
+ * density). sky_infinite (FogSettings::sky, implies fog_skybox): the sky is infinitely far, f = 0
+ * in every mode (a renderer's mist), instead of Unity's sky at the far plane. */
 FOG_FN FOG_REAL FOG_NAME(fog_factor_at)(FOG_REAL q, FOG_INT sky, int mode, int squared,
-                                        int fog_skybox, FOG_REAL k_a, FOG_REAL k_b) {
+                                        int fog_skybox, int sky_infinite, FOG_REAL k_a, FOG_REAL k_b) {
   FOG_REAL f = mode == FOG_MODE_LINEAR ? FOG_NAME(fog_factor_linear)(q, k_a, k_b)
              : mode == FOG_MODE_STEP   ? FOG_NAME(fog_factor_step)(q, k_a)
              : mode == FOG_MODE_EXP    ? FOG_NAME(fog_factor_exp)(q, k_a)
                                        : FOG_NAME(fog_factor_exp2)(q, k_a, squared);
+  if (sky_infinite) return sky ? (FOG_REAL)0 : f;
   return fog_skybox ? f : (sky ? (FOG_REAL)1 : f);
 }
 
@@ -269,25 +315,27 @@ FOG_FN FOG_REAL FOG_NAME(fog_factor_at)(FOG_REAL q, FOG_INT sky, int mode, int s
  * Linear and step: 1 - f (exact where it matters: f is then far from 1 or exactly 0 / 1).
  * Reported by the scalar path (FogResult). */
 FOG_FN FOG_REAL FOG_NAME(fog_amount_at)(FOG_REAL q, FOG_INT sky, int mode, int squared,
-                                        int fog_skybox, FOG_REAL k_a, FOG_REAL k_b) {
+                                        int fog_skybox, int sky_infinite, FOG_REAL k_a, FOG_REAL k_b) {
   FOG_REAL x = q * k_b; /* exp / exp2: density * d, or density * d^2 where squared */
   FOG_REAL a = mode == FOG_MODE_LINEAR ? (FOG_REAL)1 - FOG_NAME(fog_factor_linear)(q, k_a, k_b)
              : mode == FOG_MODE_STEP   ? (FOG_REAL)1 - FOG_NAME(fog_factor_step)(q, k_a)
              : mode == FOG_MODE_EXP    ? -expm1(-x)
                                        : -expm1(-(squared ? x * k_b : x * x));
+  if (sky_infinite) return sky ? (FOG_REAL)1 : FOG_NAME(fog_saturate)(a);
   return fog_skybox ? FOG_NAME(fog_saturate)(a) : (sky ? (FOG_REAL)0 : FOG_NAME(fog_saturate)(a));
 }
 
-/* The fog factor f of a pixel from its raw depth: the whole chain of docs/DESIGN.md §2. */
-FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray, int mode, int distance,
-                                     int fog_skybox, int reversed_z, int projection, FOG_REAL zx,
-                                     FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
+/* The fog factor f of a pixel from its depth sample (raw or linear, `kind`): the whole chain of
+ * docs/DESIGN.md §2. */
+FOG_FN FOG_REAL FOG_NAME(fog_factor)(FOG_REAL raw, FOG_REAL ray, int kind, int mode, int distance,
+                                     int fog_skybox, int sky_infinite, int reversed_z, int projection,
+                                     FOG_REAL zx, FOG_REAL zy, FOG_REAL near_plane, FOG_REAL far_plane,
                                      FOG_REAL k_a, FOG_REAL k_b) {
   FOG_INT sky;
   int squared = FOG_SQUARED(mode, distance);
-  FOG_REAL q = FOG_NAME(fog_view_distance)(raw, ray, distance, reversed_z, projection, squared,
+  FOG_REAL q = FOG_NAME(fog_view_distance)(raw, ray, kind, distance, reversed_z, projection, squared,
                                            zx, zy, near_plane, far_plane, &sky);
-  return FOG_NAME(fog_factor_at)(q, sky, mode, squared, fog_skybox, k_a, k_b);
+  return FOG_NAME(fog_factor_at)(q, sky, mode, squared, fog_skybox, sky_infinite, k_a, k_b);
 }
 
 /* Blend one channel: fogColor + f * (c - fogColor). f == 1 returns c untouched (bit-exact, NaN

@@ -32,6 +32,9 @@
 #else
 #define VOL_REVERSED_Z 0
 #endif
+#ifndef VOL_DEPTH_KIND
+#define VOL_DEPTH_KIND 0 /* FOG_DEPTH_RAW; 1 (FOG_DEPTH_EYE): linear eye depth, read as it is */
+#endif
 
 #include "volume_common.h"
 #include "volume_ray.h"
@@ -49,7 +52,7 @@ static inline void vol_composite_pixel(global const COLOR_T* color_in, global co
                                        global const float* low_key, size_t i, int x, int y) {
   float rho = 0.0f;
 #if VOL_DEPTH_AWARE && VOL_SCALE > 1
-  rho = vol_inverse_eye_depth(depth[i], frame, FOG_PROJECTION, VOL_REVERSED_Z);
+  rho = vol_inverse_eye_depth(depth[i], frame, FOG_PROJECTION, VOL_REVERSED_Z, VOL_DEPTH_KIND);
 #endif
   const float4 fog = vol_upsample(x, y, rho, low, low_key, (int)frame[VOL_F_LOW_WIDTH],
                                   (int)frame[VOL_F_LOW_HEIGHT], VOL_SCALE, VOL_DEPTH_AWARE);

@@ -21,15 +21,18 @@
  * this float (tests/volume_composite_test.cpp checks it and its neighbour). */
 #define VOL_SKY_DENOMINATOR 0x1.00068ep+0f
 
-/* 1 / eye depth of a frame pixel, from its raw depth: linear in the depth buffer for perspective
+/* 1 / eye depth of a frame pixel, from its raw depth (or linear eye depth, `kind`): linear in the depth buffer for perspective
  * cameras (q / far, q the denominator of Linear01Depth; raw / near with an infinite far plane), so
  * the composite needs no division for it. VOL_RHO_SKY for sky, and never below it. */
-VOL_FN VOL_REAL vol_inverse_eye_depth(VOL_REAL raw, VOL_GLOBAL const float* frame, int projection, int reversed_z) {
+VOL_FN VOL_REAL vol_inverse_eye_depth(VOL_REAL raw, VOL_GLOBAL const float* frame, int projection, int reversed_z,
+                                      int kind) {
   const VOL_REAL zx = VOL_P(frame, VOL_F_ZX), zy = VOL_P(frame, VOL_F_ZY);
   const VOL_REAL depth = fog_sanitize_depth(raw, reversed_z);
   VOL_REAL rho;
   int sky;
-  if (projection == FOG_PROJECTION_INFINITE_FAR) {
+  if (kind != FOG_DEPTH_RAW) { /* linear eye depth (vol_eye_depth): one division */
+    rho = (VOL_REAL)1 / fog_clamp_linear_depth(raw, VOL_P(frame, VOL_F_NEAR), VOL_P(frame, VOL_F_FAR), &sky);
+  } else if (projection == FOG_PROJECTION_INFINITE_FAR) {
     sky = depth == (VOL_REAL)0;
     rho = depth * VOL_P(frame, VOL_F_INV_NEAR);
   } else if (projection == FOG_PROJECTION_ORTHOGRAPHIC) {

@@ -73,7 +73,11 @@ typedef ushort vol_v16h_u __attribute__((__vector_size__(32), aligned(2)));
 /* vol_inverse_eye_depth (volume_composite.h) lane-wise: the same operations, selects for its branches. */
 static inline float16 vol_inverse_eye_depth_v(float16 raw, global const float* frame) {
   const float16 depth = fog_sanitize_depth_v(raw, VOL_REVERSED_Z);
-#if FOG_PROJECTION == FOG_PROJECTION_INFINITE_FAR
+#if VOL_DEPTH_KIND != FOG_DEPTH_RAW
+  int16 sky;
+  const float16 rho =
+      1.0f / fog_clamp_linear_depth_v(raw, (float16)frame[VOL_F_NEAR], (float16)frame[VOL_F_FAR], &sky);
+#elif FOG_PROJECTION == FOG_PROJECTION_INFINITE_FAR
   const int16 sky = depth == 0.0f;
   const float16 rho = depth * frame[VOL_F_INV_NEAR];
 #elif FOG_PROJECTION == FOG_PROJECTION_ORTHOGRAPHIC

@@ -293,12 +293,12 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
 /* The target pixel (lx, ly) as the march sees it: its ray, the distance along it to the occluder,
  * and the block's eye depth in *key for the upsampling. */
 VOL_FN void vol_pixel_view(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
-                           int projection, int reversed_z, VOL_V3* origin, VOL_V3* dir, VOL_REAL* t_scene,
+                           int projection, int reversed_z, int kind, VOL_V3* origin, VOL_V3* dir, VOL_REAL* t_scene,
                            VOL_REAL* key) {
   const int scale = (int)VOL_P(frame, VOL_F_SCALE);
   const VOL_REAL near_plane = VOL_P(frame, VOL_F_NEAR);
   const VOL_REAL eye_depth = vol_block_eye_depth(depth_buffer, lx, ly, scale, (int)VOL_P(frame, VOL_F_WIDTH),
-                                                 (int)VOL_P(frame, VOL_F_HEIGHT), projection, reversed_z,
+                                                 (int)VOL_P(frame, VOL_F_HEIGHT), projection, reversed_z, kind,
                                                  VOL_P(frame, VOL_F_ZX), VOL_P(frame, VOL_F_ZY), near_plane,
                                                  VOL_P(frame, VOL_F_FAR));
   *key = eye_depth;
@@ -322,10 +322,10 @@ VOL_FN VOL_V4 vol_over(VOL_V4 target, VOL_V4 c) {
 VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
                               VOL_GLOBAL const float* vols, int count, VOL_NOISE_PARAM, int noise_size,
                               VOL_GLOBAL const float* shadow_map, VOL_UINT frame_index, int integrator, int steps,
-                              int features, int jitter, int projection, int reversed_z, VOL_REAL* key) {
+                              int features, int jitter, int projection, int reversed_z, int kind, VOL_REAL* key) {
   VOL_V3 origin, dir;
   VOL_REAL t_scene;
-  vol_pixel_view(lx, ly, depth_buffer, frame, projection, reversed_z, &origin, &dir, &t_scene, key);
+  vol_pixel_view(lx, ly, depth_buffer, frame, projection, reversed_z, kind, &origin, &dir, &t_scene, key);
   const float j = vol_jitter((VOL_UINT)lx, (VOL_UINT)ly, frame_index);
   if (integrator != VOL_STYLIZED)
     return vol_physical(origin, dir, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame, noise,

@@ -41,6 +41,9 @@
 #else
 #define VOL_REVERSED_Z 0
 #endif
+#ifndef VOL_DEPTH_KIND
+#define VOL_DEPTH_KIND 0 /* FOG_DEPTH_RAW; 1 (FOG_DEPTH_EYE): linear eye depth, read as it is */
+#endif
 
 #ifdef VOL_NOISE_IMAGE
 constant sampler_t vol_noise_sampler = CLK_NORMALIZED_COORDS_TRUE | CLK_ADDRESS_REPEAT | CLK_FILTER_LINEAR;
@@ -63,7 +66,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   float key;
   const float4 r = vol_march_pixel(lx, ly, depth, frame, volumes, count, noise, noise_size, shadow_map, frame_index,
                                    VOL_INTEGRATOR, VOL_STEPS, VOL_FEATURES, VOL_JITTER, FOG_PROJECTION,
-                                   VOL_REVERSED_Z, &key);
+                                   VOL_REVERSED_Z, VOL_DEPTH_KIND, &key);
   const size_t i = (size_t)ly * (size_t)low_width + (size_t)lx;
   vstore4(r, i, low);
   low_key[i] = key;
@@ -218,7 +221,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   for (int k = 0; k < 16; ++k) {
     const int lx = min(lx0 + k, low_width - 1);
     float3 o, d;
-    vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, &o, &d, &scene[k], &key[k]);
+    vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, VOL_DEPTH_KIND, &o, &d, &scene[k], &key[k]);
     ox[k] = o.x, oy[k] = o.y, oz[k] = o.z, dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
     const float j = vol_jitter((uint)lx, (uint)ly, frame_index);
     jitter[k] = VOL_JITTER ? j : VOL_INTEGRATOR == VOL_STYLIZED ? 0.0f : 0.5f;

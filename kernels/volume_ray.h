@@ -4,10 +4,17 @@
 
 /* Projections, as fog_math.h numbers them (FOG_PROJECTION_*). */
 
-/* Eye depth (view z) of a raw depth sample, +inf for sky (docs/DESIGN.md §2's sky test; raw 0 with an
- * infinite far plane). NaN and out-of-range depths are sanitised as in the deferred pass. */
-VOL_FN VOL_REAL vol_eye_depth(VOL_REAL raw, int projection, int reversed_z, VOL_REAL zx, VOL_REAL zy,
+/* Eye depth (view z) of a depth sample, +inf for sky (docs/DESIGN.md §2's sky test; raw 0 with an
+ * infinite far plane). NaN and out-of-range depths are sanitised as in the deferred pass. kind:
+ * FOG_DEPTH_RAW, or FOG_DEPTH_EYE for linear eye depth, read as it is (fog_clamp_linear_depth; the
+ * host turns radial distance into eye depth for this pass). */
+VOL_FN VOL_REAL vol_eye_depth(VOL_REAL raw, int projection, int reversed_z, int kind, VOL_REAL zx, VOL_REAL zy,
                               VOL_REAL near_plane, VOL_REAL far_plane) {
+  if (kind != FOG_DEPTH_RAW) {
+    int sky;
+    const VOL_REAL eye = fog_clamp_linear_depth(raw, near_plane, far_plane, &sky);
+    return sky ? (VOL_REAL)INFINITY : eye;
+  }
   const VOL_REAL depth = fog_sanitize_depth(raw, reversed_z);
   if (projection == FOG_PROJECTION_INFINITE_FAR)
     return depth == (VOL_REAL)0 ? (VOL_REAL)INFINITY : fog_eye_depth_infinite(depth, near_plane);
@@ -21,14 +28,14 @@ VOL_FN VOL_REAL vol_eye_depth(VOL_REAL raw, int projection, int reversed_z, VOL_
  * (clipped to the frame): the target marches to the nearest surface of its block, and the
  * depth-aware upsampling gives the block's farther pixels the fog of neighbours that match them. */
 VOL_FN VOL_REAL vol_block_eye_depth(VOL_GLOBAL const float* depth, int lx, int ly, int scale, int width,
-                                    int height, int projection, int reversed_z, VOL_REAL zx, VOL_REAL zy,
+                                    int height, int projection, int reversed_z, int kind, VOL_REAL zx, VOL_REAL zy,
                                     VOL_REAL near_plane, VOL_REAL far_plane) {
   VOL_REAL nearest = (VOL_REAL)INFINITY;
   const int x1 = min(lx * scale + scale, width), y1 = min(ly * scale + scale, height);
   for (int y = ly * scale; y < y1; ++y)
     for (int x = lx * scale; x < x1; ++x)
       nearest = fmin(nearest, vol_eye_depth((VOL_REAL)depth[(size_t)y * (size_t)width + (size_t)x],
-                                            projection, reversed_z, zx, zy, near_plane, far_plane));
+                                            projection, reversed_z, kind, zx, zy, near_plane, far_plane));
   return nearest;
 }
 

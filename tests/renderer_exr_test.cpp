@@ -92,8 +92,8 @@ class RendererExr : public ::testing::Test {
                      bool distance = false, bool skybox = false) {
     const CliRun r = run_cli("apply " + args + " --out " + out + " --device scalar");
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    const CameraParams params = make_camera_params(camera);
-    to_raw_depth(eye, kind, params);
+    CameraParams params = make_camera_params(camera);
+    params.depth_kind = kind;  // linear depth reaches the formulas as it is, in the reference too
     const FogSettings s = fog_settings(distance, skybox);
     const FogResult<double> ref = fog_scalar<double>(color, eye, params, s);
     ExrReadRequest request;

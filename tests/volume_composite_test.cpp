@@ -181,7 +181,7 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
       low[4 * i + 3] = a;
       low_key[i] = (lx * 3 + ly) % 13 == 0 && c.depth == Depth::random ? inf
                                            : vol_block_eye_depth<float>(depth.data(), lx, ly, s, width, height, projection,
-                                                                        reversed, zx, zy, near_plane, far_plane);
+                                                                        reversed, FOG_DEPTH_RAW, zx, zy, near_plane, far_plane);
     }
   std::array<float, VOL_F_COUNT> frame{};
   frame[VOL_F_WIDTH] = float(width);
@@ -237,7 +237,7 @@ TEST_P(VolumeCompositeKernel, MatchesTheFormulasBitForBit) {
     for (int x = 0; x < width; ++x) {
       const std::size_t i = std::size_t(y) * width + x;
       const float rho =
-          c.depth_aware && s > 1 ? vol_inverse_eye_depth<float>(depth.data()[i], frame.data(), projection, reversed) : 0.0f;
+          c.depth_aware && s > 1 ? vol_inverse_eye_depth<float>(depth.data()[i], frame.data(), projection, reversed, FOG_DEPTH_RAW) : 0.0f;
       own[i] = c.depth_aware && s > 1 && on_own_surface(x, y, rho, low_key, low_width, low_height, s);
       const glm::vec4 fog = vol_upsample<float>(x, y, rho, low.data(), low_key.data(), low_width, low_height, s,
                                                 c.depth_aware);
@@ -325,17 +325,17 @@ TEST(VolumeDepthSimilarity, OwnDepthIsSimilarAndSkyIsNot) {
       detail::pack_depth_constants(frame.data(), cam);
       const int projection = int(cam.projection);
       const auto eye = [&](float raw) {
-        return vol_eye_depth<float>(raw, projection, cam.reversed_z, frame[VOL_F_ZX], frame[VOL_F_ZY],
+        return vol_eye_depth<float>(raw, projection, cam.reversed_z, FOG_DEPTH_RAW, frame[VOL_F_ZX], frame[VOL_F_ZY],
                                     frame[VOL_F_NEAR], frame[VOL_F_FAR]);
       };
       const float sky_raw = cam.reversed_z ? 0.0f : 1.0f, sky_key = eye(sky_raw);
-      const float sky_rho = vol_inverse_eye_depth<float>(sky_raw, frame.data(), projection, cam.reversed_z);
+      const float sky_rho = vol_inverse_eye_depth<float>(sky_raw, frame.data(), projection, cam.reversed_z, FOG_DEPTH_RAW);
       ASSERT_EQ(sky_key, std::numeric_limits<float>::infinity());
       EXPECT_EQ(vol_depth_difference(sky_rho, sky_key), 0.0f);
       EXPECT_EQ(vol_depth_difference(sky_rho, std::numeric_limits<float>::quiet_NaN()), 0.0f);
       for (int n = 0; n < 2000; ++n) {
         const float raw = unit(rng), key = eye(raw);
-        const float rho = vol_inverse_eye_depth<float>(raw, frame.data(), projection, cam.reversed_z);
+        const float rho = vol_inverse_eye_depth<float>(raw, frame.data(), projection, cam.reversed_z, FOG_DEPTH_RAW);
         if (key == std::numeric_limits<float>::infinity()) {
           EXPECT_EQ(vol_depth_difference(rho, key), 0.0f) << raw;
           continue;

@@ -229,6 +229,11 @@ void validate(const CameraParams& p) {
     throw Error(std::string("camera params: near (_ProjectionParams.y) must be finite and ") +
                 (ortho ? ">= 0" : "> 0") + " (got " + str(n) + ")");
   if (infinite && !p.reversed_z) throw Error("camera params: an infinite far plane needs reversed Z");
+  if (p.depth_kind != DepthKind::raw && p.depth_kind != DepthKind::eye && p.depth_kind != DepthKind::distance)
+    throw Error("camera params: depth kind " + std::to_string(int(p.depth_kind)) + " is not one of raw, eye, distance");
+  if (p.depth_kind == DepthKind::distance && ortho)
+    throw Error("camera params: radial distance depth needs a perspective camera (an orthographic camera's rays are "
+                "parallel: give eye or raw depth)");
   if (infinite ? f != INFINITY : !(f > n) || !std::isfinite(f) || (!ortho && !std::isfinite(f / n)))
     throw Error("camera params: far (_ProjectionParams.z) must be " +
                 std::string(infinite ? "+inf for the infinite-far projection" : "finite and > near, far/near finite") +

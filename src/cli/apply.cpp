@@ -187,9 +187,11 @@ void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullp
 
   job.params = frame_params(o, color, &job.camera_text);
   validate(o.settings);
-  if (kind != DepthKind::raw && job.params.projection != Projection::perspective)
-    throw Error(std::string("--depth-kind ") + to_string(kind) + " needs a perspective camera with a finite far "
-                "plane (give raw depth with --ortho-size or --infinite-far)");
+  if (kind == DepthKind::distance && job.params.projection == Projection::orthographic)
+    throw Error("--depth-kind distance needs a perspective camera (an orthographic camera's rays are parallel: "
+                "give eye or raw depth with --ortho-size)");
+  // Linear depth reaches the kernels as it is (a variant of its own), never through raw depth.
+  job.params.depth_kind = kind;
 
   if (paths.depth.empty()) {
     job.depth = std::move(job.color.depth);
@@ -209,7 +211,6 @@ void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullp
     ExrInput d = read_exr(paths.depth, depth_request);
     job.depth = std::move(d.depth);
   }
-  to_raw_depth(job.depth, kind, job.params);
 }
 
 // Frames that are done with (written outputs, fogged inputs), kept for the next frames: a fresh
@@ -358,8 +359,15 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
   }
   // docs/DESIGN.md §5: the volumes first, the deferred fog on their result. In place: the input's
   // pixels are not needed again, and a sequence allocates no extra frame.
-  if (volumes != nullptr)
+  if (volumes != nullptr && params.depth_kind == DepthKind::distance) {
+    DepthImage eye = job.depth;  // the volume pass reads eye depth (to_eye_depth: no digit lost)
+    to_eye_depth(eye, params.depth_kind, params);
+    CameraParams eye_params = params;
+    eye_params.depth_kind = DepthKind::eye;
+    volumes->apply(job.color.color, eye, job.color.color, eye_params, sequence_frame, print_setup);
+  } else if (volumes != nullptr) {
     volumes->apply(job.color.color, job.depth, job.color.color, params, sequence_frame, print_setup);
+  }
   backend.apply(color.color, job.depth, job.out, params, settings);
 }
 

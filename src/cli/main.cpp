@@ -16,10 +16,12 @@ namespace {
 using fogcl::FogMetric;
 using fogcl::FogMode;
 using fogcl::Precision;
+using fogcl::SkyDistance;
 
 const std::map<std::string, FogMode> kModes{
     {"off", FogMode::off}, {"linear", FogMode::linear}, {"exp", FogMode::exp}, {"exp2", FogMode::exp2}};
 const std::map<std::string, Precision> kPrecisions{{"precise", Precision::precise}, {"fast", Precision::fast}};
+const std::map<std::string, SkyDistance> kSkies{{"far", SkyDistance::far_plane}, {"infinite", SkyDistance::infinite}};
 
 const char* kDeviceHelp =
     "cpu (default: PoCL's CPU device), gpu, scalar (one-thread C++ path) or part of an OpenCL "
@@ -109,6 +111,13 @@ int main(int argc, char** argv) {
       ->expected(3);
   apply_cmd->add_flag("--distance", "Distance-based fog (radial) instead of depth-based");
   apply_cmd->add_flag("--fog-skybox", ap.settings.fog_skybox, "Fog the skybox too");
+  std::string sky = "far";
+  apply_cmd->add_option("--sky", sky,
+                        "Where the background is: far (Unity: at the far plane, fogged only with --fog-skybox) "
+                        "or infinite (a renderer's mist: infinitely far, fully fogged in every mode and by the "
+                        "volumes; implies --fog-skybox)")
+      ->transform(CLI::IsMember(kSkies, CLI::ignore_case))
+      ->capture_default_str();
   apply_cmd->add_option("--precision", precision, "Kernel maths: precise (default) or fast")
       ->transform(CLI::IsMember(kPrecisions, CLI::ignore_case));
   apply_cmd->add_option("--max-error", ap.max_error,
@@ -207,6 +216,7 @@ int main(int argc, char** argv) {
     if (ap.infinite_far) ap.reversed_z = true;  // an infinite far plane exists only in reversed Z
     ap.settings.mode = kModes.at(mode);
     ap.settings.precision = kPrecisions.at(precision);
+    ap.settings.sky = kSkies.at(sky);
     ap.settings.metric = apply_cmd->count("--distance") > 0 ? FogMetric::distance : FogMetric::depth;
     if (!fog_color.empty()) ap.settings.color = glm::vec3(fog_color[0], fog_color[1], fog_color[2]);
     return fogcl::cli::run_apply(ap);

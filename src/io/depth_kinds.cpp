@@ -40,8 +40,11 @@ double raw_from_eye_depth(double eye, const CameraParams& camera) {
   return std::fmin(std::fmax(raw, 0.0), 1.0);  // nearer than the near plane: the near plane
 }
 
-void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera) {
-  if (kind == DepthKind::raw) return;
+namespace {
+
+// Calls convert(depth sample, eye depth in double) for every pixel of linear depth `kind`.
+template <class Convert>
+void for_each_eye_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera, Convert&& convert) {
   validate(camera);
   if (kind == DepthKind::distance && camera.projection == Projection::orthographic)
     throw Error("depth kind distance needs a perspective camera (an orthographic camera's rays are parallel: give "
@@ -61,9 +64,21 @@ void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera)
             depth_math::fog_corner_ray_term(c, depth_math::fog_pixel_u<double>(x, inv_width), v, /*squared=*/0);
         eye = eye * ray_z / length;  // non-finite / <= 0 stay so, and become sky below
       }
-      d = float(raw_from_eye_depth(eye, camera));
+      convert(d, eye);
     }
   }
+}
+
+}  // namespace
+
+void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera) {
+  if (kind == DepthKind::raw) return;
+  for_each_eye_depth(depth, kind, camera, [&](float& d, double eye) { d = float(raw_from_eye_depth(eye, camera)); });
+}
+
+void to_eye_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera) {
+  if (kind != DepthKind::distance) return;
+  for_each_eye_depth(depth, kind, camera, [](float& d, double eye) { d = float(eye); });
 }
 
 }  // namespace fogcl

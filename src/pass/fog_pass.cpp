@@ -5,6 +5,7 @@
 
 #include "deferred_fog_cl.h"
 #include "fogcl/error.h"
+#include "pass/formulas.h"
 #include "runtime/clhpp.h"
 #include "runtime/frame_buffers.h"
 #include "settings/fog_coefficients.h"
@@ -152,7 +153,7 @@ cl_event FogPass::Impl::dispatch(const cl::CommandQueue& queue, const FrameBuffe
     return share(done);
   }
   const detail::FogCoefficients<float> k = detail::fog_coefficients<float>(settings, v.mode);
-  const auto& c = camera.frustum_corners;
+  const auto c = formulas::fog_ray_corners(camera);
   kernel->setArg(0, wrap(fb.color_in));
   kernel->setArg(1, wrap(fb.depth));
   kernel->setArg(2, wrap(fb.color_out));

@@ -58,4 +58,14 @@ template <class T>
                         T(corners[kTopRight][k]), u, v);
   return fog_ray_term(ray[0], ray[1], ray[2], squared);
 }
+
+// The corner rays the formulas interpolate (kernel arguments and the scalar path alike): at the
+// far plane for raw depth (Linear01Depth scales them); at view z = 1 for linear depth, which
+// scales them by eye depth (fog_view_distance_linear). Infinite-far corners are at z = 1 already.
+inline std::array<glm::vec3, 4> fog_ray_corners(const CameraParams& camera) {
+  std::array<glm::vec3, 4> corners = camera.frustum_corners;
+  if (camera.depth_kind != DepthKind::raw && camera.projection == Projection::perspective)
+    for (glm::vec3& c : corners) c = glm::vec3(c.x / c.z, c.y / c.z, 1.0f);
+  return corners;
+}
 }  // namespace fogcl::formulas

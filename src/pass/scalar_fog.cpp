@@ -55,23 +55,25 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
   const T zx = T(cam.zbuffer_params.x), zy = T(cam.zbuffer_params.y);
   const T near_plane = T(cam.near_plane()), far_plane = T(cam.far_plane());
   const T fog[3] = {T(s.color.r), T(s.color.g), T(s.color.b)};
-  const auto& cn = cam.frustum_corners;
+  const auto cn = fog_ray_corners(cam);
   const float* raw_depth = depth.data();
   const int mode = int(v.mode), distance = v.distance, skybox = v.fog_skybox, reversed = v.reversed_z;
   const int projection = int(v.projection), squared = FOG_SQUARED(mode, distance);
+  const int kind = int(v.depth_kind), sky_infinite = v.sky_infinite;
+  const int needs_ray = FOG_NEEDS_RAY(distance, kind), ray_squared = FOG_RAY_SQUARED(mode, distance, kind);
   const T inv_width = T(1) / T(w);
   for (int y = y0; y < y1; ++y) {
     const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-      const T ray = distance ? fog_corner_ray_term(cn, fog_pixel_u(T(x), inv_width), vv, squared) : T(0);
+      const T ray = needs_ray ? fog_corner_ray_term(cn, fog_pixel_u(T(x), inv_width), vv, ray_squared) : T(0);
       T f = 1, amount = 0;
       if (v.needs_pass()) {
         int sky;
-        const T q = fog_view_distance(T(raw_depth[i]), ray, distance, reversed, projection, squared, zx,
+        const T q = fog_view_distance(T(raw_depth[i]), ray, kind, distance, reversed, projection, squared, zx,
                                       zy, near_plane, far_plane, &sky);
-        f = fog_factor_at(q, sky, mode, squared, skybox, k.a, k.b);
-        if (with_amount) amount = fog_amount_at(q, sky, mode, squared, skybox, k.a, k.b);
+        f = fog_factor_at(q, sky, mode, squared, skybox, sky_infinite, k.a, k.b);
+        if (with_amount) amount = fog_amount_at(q, sky, mode, squared, skybox, sky_infinite, k.a, k.b);
       }
       const Channel* c = color + 4 * i;
       T rgba[4];

@@ -38,6 +38,8 @@ void validate(const FogSettings& s) {
     throw Error("precision " + std::to_string(int(s.precision)) + " is not one of precise, fast");
   if (s.metric != FogMetric::depth && s.metric != FogMetric::distance)
     throw Error("fog metric " + std::to_string(int(s.metric)) + " is not one of depth, distance");
+  if (s.sky != SkyDistance::far_plane && s.sky != SkyDistance::infinite)
+    throw Error("sky distance " + std::to_string(int(s.sky)) + " is not one of far, infinite");
 }
 
 const char* to_string(FogMode mode) {
@@ -53,5 +55,6 @@ const char* to_string(FogMode mode) {
 const char* to_string(FogMetric metric) { return metric == FogMetric::distance ? "distance" : "depth"; }
 
 const char* to_string(Precision p) { return p == Precision::fast ? "fast" : "precise"; }
+const char* to_string(SkyDistance sky) { return sky == SkyDistance::infinite ? "infinite" : "far"; }
 
 }  // namespace fogcl

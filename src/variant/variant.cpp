@@ -28,8 +28,10 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
   // the variant carries no ray interpolation and no sqrt for it.
   v.projection = camera.projection;
   v.distance = s.metric == FogMetric::distance && camera.projection != Projection::orthographic;
-  v.fog_skybox = s.fog_skybox;
+  v.sky_infinite = s.sky == SkyDistance::infinite;
+  v.fog_skybox = s.fog_skybox || v.sky_infinite;
   v.reversed_z = camera.reversed_z;
+  v.depth_kind = camera.depth_kind;
   v.storage = storage;
   v.precision = s.precision;
   return v;
@@ -88,6 +90,8 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.distance) o += " -D FOG_DISTANCE";
   if (v.fog_skybox) o += " -D FOG_SKYBOX";
   if (v.reversed_z) o += " -D REVERSED_Z";
+  if (v.sky_infinite) o += " -D FOG_SKY_INFINITE";
+  if (v.depth_kind != DepthKind::raw) o += " -D FOG_DEPTH_KIND=" + std::to_string(int(v.depth_kind));
   if (v.projection != Projection::perspective) o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
@@ -112,7 +116,9 @@ std::string describe(const Variant& v) {
   if (!v.needs_pass()) return "none (no pass)";
   std::string d = to_string(v.mode);
   d += v.distance ? " distance" : " depth";
-  d += v.fog_skybox ? " fog-skybox" : " sky-test";
+  d += v.sky_infinite ? " sky-infinite" : v.fog_skybox ? " fog-skybox" : " sky-test";
+  if (v.depth_kind == DepthKind::eye) d += " eye-depth";
+  if (v.depth_kind == DepthKind::distance) d += " radial-distance";
   d += v.reversed_z ? " reversed-z" : " conventional-z";
   d += v.projection == Projection::orthographic ? " orthographic "
        : v.projection == Projection::perspective_infinite_far ? " infinite-far " : " ";

@@ -201,7 +201,8 @@ float max_eye_depth(const DepthImage& depth, const CameraParams& camera) {
   const float zx = camera.zbuffer_params.x, zy = camera.zbuffer_params.y;
   float farthest = 0.0f;
   for (std::size_t i = 0; i < depth.pixel_count(); ++i) {
-    const float e = volume_formulas::vol_eye_depth(depth.data()[i], int(camera.projection), camera.reversed_z, zx, zy,
+    const float e = volume_formulas::vol_eye_depth(depth.data()[i], int(camera.projection), camera.reversed_z,
+                                                   int(camera.depth_kind), zx, zy,
                                                    camera.near_plane(), camera.far_plane());
     if (!(e < kInf)) return kInf;
     farthest = std::fmax(farthest, e);
@@ -229,6 +230,9 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   if (width < 1 || height < 1)
     throw Error("frame size must be at least 1x1 (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
   validate(settings);
+  if (camera.depth_kind == DepthKind::distance)
+    throw Error("the volume pass reads raw or eye depth, not radial distance: convert it with to_eye_depth() "
+                "(fogcl/depth_kinds.h), which keeps every digit");
   if (shadow) {
     validate(*shadow);
     if (shadow_width < 1 || shadow_height < 1)
@@ -250,6 +254,7 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   v.jitter = settings.jitter;
   v.projection = camera.projection;
   v.reversed_z = camera.reversed_z;
+  v.depth_kind = camera.depth_kind;
   v.noise_sampling = settings.noise_sampling;
   v.scale = s;
   v.depth_aware = settings.upsampling == VolumeUpsampling::depth_aware;
@@ -350,6 +355,7 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
   o += " -D VOL_JITTER=" + std::to_string(v.jitter ? 1 : 0);
   o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.reversed_z) o += " -D REVERSED_Z";
+  if (v.depth_kind != DepthKind::raw) o += " -D VOL_DEPTH_KIND=" + std::to_string(int(v.depth_kind));
   if (v.noise_sampling == NoiseSampling::image && (v.features & VOL_FEATURE_NOISE)) o += " -D VOL_NOISE_IMAGE";
   if (v.noise_sampling == NoiseSampling::buffer && (v.features & VOL_FEATURE_NOISE) && !device.cpu)
     o += " -D VOL_TEXEL_WORD_LOADS";  // kernels/volume_noise.h: GPUs only
@@ -362,6 +368,7 @@ std::string volume_composite_options(const VolumeVariant& v, const DeviceTraits&
   o += " -D VOL_DEPTH_AWARE=" + std::to_string(v.depth_aware ? 1 : 0);
   o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.reversed_z) o += " -D REVERSED_Z";
+  if (v.depth_kind != DepthKind::raw) o += " -D VOL_DEPTH_KIND=" + std::to_string(int(v.depth_kind));
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   o += " -D VOL_LANES=" + std::to_string(pixels_per_work_item(device));
   o += streaming_store_option(device, v.storage);  // as the deferred pass's (variant.h)

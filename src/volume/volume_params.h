@@ -24,6 +24,7 @@ struct VolumeVariant {
   bool jitter = true;
   Projection projection = Projection::perspective;
   bool reversed_z = false;
+  DepthKind depth_kind = DepthKind::raw;  // VOL_DEPTH_KIND: raw or eye (radial distance arrives as eye depth)
   NoiseSampling noise_sampling = NoiseSampling::buffer;
   int scale = 2;
   bool depth_aware = true;

@@ -38,7 +38,7 @@ VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, co
   const std::uint8_t* noise = f.needs_noise()
                                   ? detail::shared_noise_texture(settings.noise_size, settings.noise_seed).texels.data()
                                   : nullptr;
-  const int projection = int(v.projection), reversed = v.reversed_z;
+  const int projection = int(v.projection), reversed = v.reversed_z, kind = int(v.depth_kind);
   const float* shadow_map = shadow ? shadow->depth.data() : nullptr;
   const int integrator = detail::integrator_code(v.integrator);
   r.low_width = f.low_width;
@@ -51,7 +51,7 @@ VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, co
       T key;
       const glm::vec<4, T> p = vol_march_pixel<T>(
           lx, ly, depth.data(), f.frame.data(), f.volumes.data(), int(f.visible.size()), noise, settings.noise_size,
-          shadow_map, scene.frame_index, integrator, v.steps, v.features, v.jitter, projection, reversed, &key);
+          shadow_map, scene.frame_index, integrator, v.steps, v.features, v.jitter, projection, reversed, kind, &key);
       for (int k = 0; k < 4; ++k) r.low[4 * i + k] = p[k];
       r.low_key[i] = key;
     }
@@ -59,7 +59,7 @@ VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, co
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * w + x;
-      const T rho = v.depth_aware && v.scale > 1 ? vol_inverse_eye_depth(T(depth.data()[i]), k, projection, reversed)
+      const T rho = v.depth_aware && v.scale > 1 ? vol_inverse_eye_depth(T(depth.data()[i]), k, projection, reversed, kind)
                                                  : T(0);
       const glm::vec<4, T> fog =
           vol_upsample(x, y, rho, r.low.data(), r.low_key.data(), f.low_width, f.low_height, v.scale, v.depth_aware);

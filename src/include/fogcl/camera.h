@@ -39,6 +39,14 @@ enum class Projection {
   orthographic,              // Linear01Depth = x * raw + y (linear); rays are parallel
 };
 
+// What the depth buffer holds; linear kinds are kernel variants of their own and reach the formulas
+// as they are, never through raw depth (docs/accuracy.md, "Linear depth").
+enum class DepthKind {
+  raw,       // raw device depth in [0, 1] (the depth buffer's value)
+  eye,       // linear eye depth along the view axis [world units] (Unity's LinearEyeDepth, EXR Z)
+  distance,  // radial distance from the eye [world units] (|view-space position|); perspective only
+};
+
 // Corner order used by fogcl: bottom-left, bottom-right, top-left, top-right (index u + 2v).
 enum Corner { kBottomLeft = 0, kBottomRight = 1, kTopLeft = 2, kTopRight = 3 };
 
@@ -55,6 +63,9 @@ struct CameraParams {
   std::array<glm::vec3, 4> frustum_corners{};
   bool reversed_z = false;
   Projection projection = Projection::perspective;
+  // What the depth buffer holds. Linear depth: values nearer than near are the near plane, values
+  // from 0.9999 far on (and +inf, NaN, <= 0) are sky, as raw depth's clamp and sky test make them.
+  DepthKind depth_kind = DepthKind::raw;
 
   float near_plane() const { return projection_params.y; }
   float far_plane() const { return projection_params.z; }

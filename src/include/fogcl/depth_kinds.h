@@ -10,12 +10,6 @@
 
 namespace fogcl {
 
-enum class DepthKind {
-  raw,       // raw device depth in [0, 1] (the depth buffer's value); used as is
-  eye,       // linear eye depth along the view axis [world units] (Unity's LinearEyeDepth)
-  distance,  // radial distance from the eye [world units] (|view-space position|)
-};
-
 const char* to_string(DepthKind kind);
 // "raw", "eye" or "distance"; throws fogcl::Error naming the value otherwise.
 DepthKind parse_depth_kind(const std::string& text);
@@ -37,5 +31,11 @@ double raw_from_eye_depth(double eye, const CameraParams& camera);
 // normalised to view z = 1). raw: nothing changes. Throws fogcl::Error for distance with an
 // orthographic camera (parallel rays: no distance from the eye).
 void to_raw_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera);
+
+// Radial distance to linear eye depth in place (eye = distance / |ray1(u, v)|, ray1 the pixel's ray
+// at view z = 1, in double, rounded once: no digit depends on near), for the volume pass, which
+// reads raw or eye depth. raw and eye: nothing changes. Throws fogcl::Error for distance with an
+// orthographic camera.
+void to_eye_depth(DepthImage& depth, DepthKind kind, const CameraParams& camera);
 
 }  // namespace fogcl

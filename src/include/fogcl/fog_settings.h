@@ -17,6 +17,12 @@ enum class FogMetric {
   distance,  // d = |ray(u, v)| * Linear01Depth (radial distance from the eye)
 };
 
+// How far the sky (the background: raw depth at the far end, linear depth +inf or beyond far) is.
+enum class SkyDistance {
+  far_plane,  // at the far plane (Unity): fogged as d = far - near, and only with fog_skybox
+  infinite,   // infinitely far (a renderer's mist pass): fully fogged in every mode; implies fog_skybox
+};
+
 // Precision of the kernel maths (docs/DESIGN.md §4). The scalar path ignores it.
 enum class Precision {
   precise,  // OpenCL default maths (built-ins within their spec ulp bounds); the default
@@ -31,6 +37,7 @@ struct FogSettings {
   float density = 0.01f;                  // exp/exp2 [1/world unit]; finite, >= 0
   FogMetric metric = FogMetric::depth;
   bool fog_skybox = false;                 // false: sky pixels (Linear01Depth > 0.9999) stay unfogged
+  SkyDistance sky = SkyDistance::far_plane;  // infinite: the sky is fully fogged (fog_skybox implied)
   Precision precision = Precision::precise;
 };
 
@@ -41,5 +48,6 @@ void validate(const FogSettings& settings);
 const char* to_string(FogMode mode);
 const char* to_string(FogMetric metric);
 const char* to_string(Precision precision);
+const char* to_string(SkyDistance sky);
 
 }  // namespace fogcl

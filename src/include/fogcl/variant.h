@@ -25,6 +25,8 @@ struct Variant {
   bool distance = false;    // FOG_DISTANCE
   bool fog_skybox = false;  // FOG_SKYBOX (no sky test)
   bool reversed_z = false;  // REVERSED_Z
+  bool sky_infinite = false;  // FOG_SKY_INFINITE (with fog_skybox): the sky fully fogged
+  DepthKind depth_kind = DepthKind::raw;  // FOG_DEPTH_KIND (1 eye depth, 2 radial distance)
   Projection projection = Projection::perspective;  // FOG_PROJECTION (1 infinite far, 2 orthographic)
   ColorFormat storage = ColorFormat::rgba32f;  // FOG_COLOR_HALF
   Precision precision = Precision::precise;    // FOG_NATIVE_MATH + -cl-fast-relaxed-math
@@ -32,7 +34,8 @@ struct Variant {
   bool needs_pass() const { return mode != KernelMode::none; }
   bool operator==(const Variant& o) const {
     return mode == o.mode && distance == o.distance && fog_skybox == o.fog_skybox &&
-           reversed_z == o.reversed_z && projection == o.projection && storage == o.storage &&
+           reversed_z == o.reversed_z && sky_infinite == o.sky_infinite && depth_kind == o.depth_kind &&
+           projection == o.projection && storage == o.storage &&
            precision == o.precision;
   }
 };
