@@ -383,7 +383,7 @@ def readme_speed(root):
     f = lambda v: f"{v:.2f} ms"
     rows = [
         ["deferred fog, 1080p exp2 RGBA32F, device time", "2-core EPYC", f(dev["real_time"]),
-         f"2-thread memcpy of the frame's bytes, {f(dev['memcpy2_ms'])}", f"{dev['vs_memcpy2']:.2f}× faster",
+         f"2-thread memcpy of the frame's bytes, same iterations, {f(dev['memcpy2_ms'])}", f"{dev['vs_memcpy2']:.2f}× faster",
          d2.date, src(d2.rel)],
         ["the same, whole host call (`FogPass::apply`)", "2-core EPYC", f(call["real_time"]),
          f"Halide 14, whole `realize()`, {f(hal['real_time'])}", f"{hal['real_time'] / call['real_time']:.2f}× faster",
@@ -411,7 +411,7 @@ def readme_speed(root):
          f"OpenEXR alone, {x16[1]:.2f} frames/s", f"{x16[0] / x16[1]:.2f}×", "2026-11-24",
          src("device-16core-2026-11-24/t16.json")],
     ]
-    header = ["what", "machine", "fogcl", "peer", "fogcl against it", "date", "result file"]
+    header = ["what", "machine", "fogcl", "peer (or target)", "fogcl against it", "date", "result file"]
     return table(header, rows, ["---"] * 7).replace("](../bench/", "](bench/")
 
 
@@ -428,7 +428,7 @@ def readme_accuracy(root):
 
     rows = []
     for f16, name in ((0, "RGBA32F"), (1, "RGBA16F")):
-        rows.append([f"deferred fog, 12 modes × metrics at 1080p and 4K, {name}", "2-core EPYC",
+        rows.append([f"deferred fog, linear / exp / exp2 × depth / distance at 1080p and 4K, {name}", "2-core EPYC",
                      g3(worst(d2, "BM_OpenCLDevice", f16, nt=2)),
                      f"Halide 14 (same formulas): {g3(worst(d2, 'BM_Halide', f16))}; OpenMP C++: "
                      f"{g3(worst(suite, 'BM_OpenMPSimd', f16))}", d2.date, src(d2.rel)])
