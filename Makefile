@@ -23,7 +23,7 @@ bench: build
 	scripts/setup.sh --bench
 	bench/run.sh $(BUILD) out/bench
 
-# What the GPU machine needs, in out/gpu-bundle: carry it there and run its gpu-run.sh (README, "On a GPU").
+# What the GPU machine needs, in out/gpu-bundle: carry it there and run its gpu-run.sh (docs/gpu.md).
 gpu-bundle:
 	scripts/gpu-bundle.sh $(BUILD) out/gpu-bundle
 

@@ -4,7 +4,7 @@
 # The bundle: bin/ (the CLI, the test suite, both benchmarks, the sequence peer and generator), lib/ (every shared library they
 # load, glibc's own excepted: gpu-run.sh links only those the GPU machine lacks), gpu-run.sh and
 # gpu_summary.py. Then, on the GPU machine, from the bundle: ./gpu-run.sh RESULTS_DIR
-# (README, "On a GPU").
+# (docs/gpu.md).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(dirname "$here")
