@@ -31,7 +31,7 @@ gpu-bundle:
 # and the libFuzzer targets over EXR loading and VOLUMES.json, from one build folder.
 # detect_leaks=0: PoCL and the OpenCL ICD loader keep process-lifetime allocations (LLVM's JIT
 # state, the platform list) that LeakSanitizer reports at exit; fogcl's own leaks would show in the
-# scalar/IO tests, see README.
+# scalar/IO tests (docs/cli.md, "Errors").
 ASAN_BUILD ?= build-asan
 SANITIZE := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_SECONDS ?= 30
