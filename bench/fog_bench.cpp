@@ -390,7 +390,7 @@ void BM_OpenCLHostCall(benchmark::State& state) {
     return call;
   });
   // The whole call against its own kernel in the same iterations: two benchmarks minutes apart
-  // see different machines (README, "Against Halide, and the host call").
+  // see different machines (docs/performance.md, "The host call").
   state.counters["kernel_ms"] = kernel_ms / double(state.iterations());
   state.counters["call_vs_kernel"] = kernel_ms > 0 ? call_ms / kernel_ms : 0.0;
 }

@@ -123,7 +123,7 @@ TEST_P(CpuBlockPaths, FollowTheBlendRulesAndMatchThePortablePath) {
       if (std::memcmp(pixel_bytes(target, i), pixel_bytes(t.color, i), bpp) != 0) ++rule_breaks;
     } else if (f32.factor[i] == 0.0f) {
       ++zeros;
-      // RGB exactly the fog color (stored), alpha the input's bits (README: a NaN alpha of a
+      // RGB exactly the fog color (stored), alpha the input's bits (docs/accuracy.md: a NaN alpha of a
       // fogged half pixel may be quieted).
       fog_pixel.set_pixel(0, 0, glm::vec4(s.color, t.color.pixel(x, y).a));
       const std::size_t channel = bpp / 4;
