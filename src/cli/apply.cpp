@@ -58,6 +58,12 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
   camera.far_plane = o.far_plane;
   camera.reversed_z = o.reversed_z;
   camera.infinite_far = o.infinite_far;
+  if (o.camera.lens) {  // lens data: the fov for this frame's aspect (cli/camera_cli.h)
+    camera.aspect = o.aspect != 0.0f ? o.aspect : float(color.color.width()) / float(color.color.height());
+    camera.fov_y_deg = lens_fov_deg(o.camera, camera.aspect);
+    *from = std::string("--focal-length, --sensor-fit ") + to_string(o.camera.lens->fit);
+    return camera;
+  }
   if (o.fov != 0.0f) {
     camera.fov_y_deg = o.fov;
     *from = "flags";
@@ -150,6 +156,8 @@ struct FrameJob {
   DepthImage depth;    // raw device depth
   CameraParams params;
   std::string camera_text;
+  std::optional<CameraPose> pose;  // for the volumes, when it comes with the frame (cli/camera_cli.h)
+  std::string pose_from;
   ColorImage out;      // the fogged frame
 };
 
@@ -186,6 +194,7 @@ void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullp
   const ExrInput& color = job.color;
 
   job.params = frame_params(o, color, &job.camera_text);
+  job.pose = frame_pose(o.camera, o.volumes, color, &job.pose_from);
   validate(o.settings);
   if (kind == DepthKind::distance && job.params.projection == Projection::orthographic)
     throw Error("--depth-kind distance needs a perspective camera (an orthographic camera's rays are parallel: "
@@ -357,6 +366,7 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
                  o.compression.empty() ? (std::string(exr_compression_name(color.compression)) + " (the input's)").c_str()
                                        : o.compression.c_str());
   }
+  if (volumes != nullptr) volumes->set_frame_pose(job.pose, job.pose_from);
   // docs/DESIGN.md §5: the volumes first, the deferred fog on their result. In place: the input's
   // pixels are not needed again, and a sequence allocates no extra frame.
   if (volumes != nullptr && params.depth_kind == DepthKind::distance) {

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/camera_cli.h"
 #include "cli/volumes_cli.h"
 #include "fogcl/fogcl.h"
 
@@ -62,6 +63,7 @@ struct ApplyOptions {
   std::string device;
   bool verbose = false;
   VolumeCliOptions volumes;        // --volumes and its flags (cli/volumes_cli.h)
+  CameraCliOptions camera;         // --camera-to-world, --axes, the lens flags (cli/camera_cli.h)
 };
 int run_apply(const ApplyOptions& options);
 

@@ -129,6 +129,7 @@ int main(int argc, char** argv) {
   apply_cmd->add_option("--device", ap.device, kDeviceHelp);
   apply_cmd->add_flag("--verbose", ap.verbose, "Print the device, the kernel variant chosen and why");
   fogcl::cli::add_volume_options(*apply_cmd, ap.volumes);
+  fogcl::cli::add_camera_options(*apply_cmd, ap.camera);
 
   fogcl::cli::ReportCliOptions report;
   CLI::App* report_cmd = app.add_subcommand(
@@ -191,6 +192,7 @@ int main(int argc, char** argv) {
       return fogcl::cli::run_report(report);
     }
     fogcl::cli::note_given_volume_flags(*apply_cmd, ap.volumes);
+    fogcl::cli::resolve_camera_flags(*apply_cmd, ap);
     // With volumes the deferred fog is optional: no --mode runs only the volumetric pass.
     if (apply_cmd->count("--mode") == 0) {
       if (ap.volumes.volumes_path.empty()) throw fogcl::cli::UsageError("--mode is required (off, linear, exp or exp2)");

@@ -153,16 +153,58 @@ struct KeyReader {
   }
 };
 
+// The keys a homogeneous medium refuses, and why.
+const std::map<std::string, std::string> kNotHomogeneous{
+    {"noise", "it has no noise"},
+    {"fade_edge", "it has no fades"},
+    {"proximity_fade", "it has no fades"},
+    {"fade_y", "it has no fades"},
+    {"max_y", "it has no height fade"},
+    {"fog_exponent", "it has no noise to shape"},
+    {"fog_cutoff", "it has no noise to shape"},
+    {"detail_exponent", "it has no noise to shape"},
+    {"detail_strength", "it has no noise to shape"},
+    {"tiling", "it has no noise to shape"},
+    {"speed", "it has no noise to shape"},
+    {"detail_tiling", "it has no noise to shape"},
+    {"detail_speed_modifier", "it has no noise to shape"},
+};
+// A homogeneous medium's max_y: fogcl::validate's largest (|max_y| <= 3.4e38).
+constexpr float kHomogeneousMaxY = 3.4e38f;
+
 FogVolume parse_volume(const json& j, const KeyReader& r) {
   if (!j.is_object())
     throw Error(r.where + "must be an object {\"center\": [x, y, z], \"radius\": r, ...} (got " + shown(j) + ")");
   if (!j.contains("center")) throw Error(r.where + "'center' is missing (every volume needs \"center\": [x, y, z])");
   if (!j.contains("radius")) throw Error(r.where + "'radius' is missing (every volume needs \"radius\": r > 0)");
   FogVolume v;
+  // "medium": "homogeneous": a plain medium in one key. The seed's defaults are a stylized look
+  // (noise, three fades, albedo = fog colour, ambient 0.1 x light); a homogeneous medium is the
+  // sphere at constant density: no noise, no fades (no height ceiling), and lit only as asked:
+  // albedo 0 (a pure absorber) and ambient 0 unless "albedo" / "ambient" say otherwise. The keys
+  // that would make it inhomogeneous (noise and fades) or that only shape noise are refused with it.
+  const bool homogeneous = j.contains("medium");
+  if (homogeneous) {
+    const json& m = j["medium"];
+    if (!m.is_string() || m.get<std::string>() != "homogeneous")
+      r.fail("medium", "must be \"homogeneous\" (a plain medium: no noise, no fades, albedo and ambient 0 unless "
+             "given; leave the key out for the seed's noisy, faded fog)", shown(m));
+    v.noise = false;
+    v.fade_edge = 0.0f;
+    v.proximity_fade = 0.0f;
+    v.fade_y = 0.0f;
+    v.max_y = kHomogeneousMaxY;  // with fade_y 0 a hard ceiling, above anything finite a scene holds
+    v.albedo = glm::vec3(0.0f);
+    v.ambient = glm::vec3(0.0f);
+  }
   for (const auto& item : j.items()) {
     // Named copies, not structured bindings: lambdas below use them (C++17 cannot capture bindings).
     const std::string key = item.key();
     const nlohmann::json& value = item.value();
+    if (key == "medium") continue;  // read above
+    if (homogeneous && kNotHomogeneous.count(key) > 0)
+      r.fail(key, "does not go with \"medium\": \"homogeneous\" (" + kNotHomogeneous.at(key) +
+             "; remove the key, or the medium for the seed's fog)", shown(value));
     const auto field = volume_fields().find(key);
     if (field == volume_fields().end()) {
       std::string best;
@@ -538,22 +580,33 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     if (!o.given.empty()) throw Error(o.given.front() + " needs --volumes (it sets up the volumetric pass)");
     return nullptr;
   }
-  for (const char* flag : {"--eye", "--forward", "--up"})
-    if (!given(o, flag)) throw UsageError(std::string(flag) + " is required with --volumes (the camera pose, X,Y,Z)");
+  if (!o.pose_per_frame)  // else each frame brings its pose (set_frame_pose)
+    for (const char* flag : {"--eye", "--forward", "--up"})
+      if (!given(o, flag))
+        throw UsageError(std::string(flag) + " is required with --volumes (the camera pose, X,Y,Z; or give "
+                         "--camera-to-world, or none of --eye/--forward/--up to take the color file's worldToCamera)");
   auto stage = std::unique_ptr<VolumeStage>(new VolumeStage);
   VolumeStage& s = *stage;
   s.options_ = o;
+  // With --axes every world-space input below is in the renderer's world (the pose, the light
+  // direction, the shadow matrix, the volumes): mapped into fogcl's here (fogcl/renderer_camera.h).
+  const Axes axes = o.axes.value_or(Axes::unity);
+  const glm::mat3 to_fogcl = axes_to_fogcl(axes);
 
   // Camera pose and light, each checked with the flag's name before the library's own rules.
-  s.pose_.eye = parse_vec3("--eye", o.eye);
-  s.pose_.forward = parse_vec3("--forward", o.forward);
-  s.pose_.up = parse_vec3("--up", o.up);
-  if (s.pose_.forward == glm::vec3(0.0f)) throw Error("--forward must be a non-zero vector (got '" + o.forward + "')");
-  if (s.pose_.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + o.up + "')");
-  try {
-    validate(s.pose_);
-  } catch (const Error& e) {
-    throw Error(std::string("--forward/--up: ") + e.what());
+  if (!o.pose_per_frame) {
+    s.pose_.eye = parse_vec3("--eye", o.eye);
+    s.pose_.forward = parse_vec3("--forward", o.forward);
+    s.pose_.up = parse_vec3("--up", o.up);
+    if (s.pose_.forward == glm::vec3(0.0f)) throw Error("--forward must be a non-zero vector (got '" + o.forward + "')");
+    if (s.pose_.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + o.up + "')");
+    try {
+      validate(s.pose_);
+    } catch (const Error& e) {
+      throw Error(std::string("--forward/--up: ") + e.what());
+    }
+    s.pose_ = {to_fogcl * s.pose_.eye, to_fogcl * s.pose_.forward, to_fogcl * s.pose_.up};
+    s.pose_from_ = std::string("--eye/--forward/--up") + (o.axes ? std::string(", --axes ") + to_string(axes) : "");
   }
   s.light_.direction = parse_vec3("--light-dir", o.light_dir);
   s.light_.color = parse_vec3("--light-color", o.light_color);
@@ -562,6 +615,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
   for (int k = 0; k < 3; ++k)
     if (s.light_.color[k] < 0.0f)
       throw Error("--light-color must be >= 0 in each channel (got '" + o.light_color + "')");
+  s.light_.direction = to_fogcl * s.light_.direction;
 
   if (!std::isfinite(o.time)) throw Error("--time must be finite (got " + str(o.time) + ")");
   if (!(std::isfinite(o.fps) && o.fps > 0.0)) throw Error("--fps must be finite and > 0 (got " + str(o.fps) + ")");
@@ -589,8 +643,8 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
   if (matrix && !map) throw Error("--light-view-proj needs --shadow-map (the light's depth)");
   if (o.shadow_reversed_z && !map) throw Error("--shadow-reversed-z needs --shadow-map");
   if (map) {
-    // The matrix first: a bad matrix fails before the file is read.
-    const glm::mat4 m = parse_light_view_proj(o.light_view_proj);
+    // The matrix first: a bad matrix fails before the file is read. It takes the renderer's world.
+    const glm::mat4 m = world_matrix_to_fogcl(axes, parse_light_view_proj(o.light_view_proj));
     ShadowMapParams p;
     p.world_to_light_clip = m;
     p.reversed_z = o.shadow_reversed_z;
@@ -616,6 +670,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
   }
 
   s.volumes_ = read_volumes_json(o.volumes_path);
+  for (FogVolume& v : s.volumes_) v = volume_to_fogcl(axes, v);
   s.runtime_ = runtime;
   if (runtime != nullptr) s.pass_ = std::make_unique<VolumePass>(*runtime);
   return stage;
@@ -624,7 +679,9 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
 VolumeScene VolumeStage::scene_for(int sequence_frame) const {
   VolumeScene scene;
   scene.volumes = volumes_;
-  scene.pose = pose_;
+  if (options_.pose_per_frame && !frame_pose_)
+    throw Error("--volumes: no camera pose for this frame (set_frame_pose was not called)");
+  scene.pose = options_.pose_per_frame ? *frame_pose_ : pose_;
   scene.light = light_;
   const bool sequence = sequence_frame >= 0;
   scene.frame_index = std::uint32_t(given(options_, "--frame") ? options_.frame : sequence ? sequence_frame : 0);
@@ -632,6 +689,12 @@ VolumeScene VolumeStage::scene_for(int sequence_frame) const {
                      : sequence                ? double(sequence_frame) / options_.fps
                                                : 0.0);
   return scene;
+}
+
+void VolumeStage::set_frame_pose(const std::optional<CameraPose>& pose, const std::string& from) {
+  if (!options_.pose_per_frame) return;
+  frame_pose_ = pose;
+  pose_from_ = from;
 }
 
 void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
@@ -692,6 +755,10 @@ void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImag
       "volumes: %zu of %zu visible (%s), %s integrator, %d steps, %s resolution (%dx%d target), %s upsampling\n",
       visible, scene.volumes.size(), options_.volumes_path.c_str(), to_string(settings_.integrator), settings_.steps,
       resolution_name(s), (in.width() + s - 1) / s, (in.height() + s - 1) / s, to_string(settings_.upsampling));
+  const CameraPose& p = scene.pose;
+  std::fprintf(stderr, "  camera pose (fogcl's world): eye (%g, %g, %g), forward (%g, %g, %g), up (%g, %g, %g), from %s\n",
+               double(p.eye.x), double(p.eye.y), double(p.eye.z), double(p.forward.x), double(p.forward.y),
+               double(p.forward.z), double(p.up.x), double(p.up.y), double(p.up.z), pose_from_.c_str());
   std::fprintf(stderr, "  noise: %d^3 texels, seed %u, %s sampling; shadow map: %s\n", settings_.noise_size,
                unsigned(settings_.noise_seed), to_string(settings_.noise_sampling),
                shadow_ ? (std::to_string(shadow_->depth.width()) + "x" + std::to_string(shadow_->depth.height()) +

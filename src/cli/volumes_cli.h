@@ -5,12 +5,14 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/mat4x4.hpp>
 
 #include "fogcl/fogcl.h"
+#include "fogcl/renderer_camera.h"
 #include "fogcl/volume_pass.h"
 #include "fogcl/volumes.h"
 
@@ -37,6 +39,11 @@ struct VolumeCliOptions {
   // volumetric error budget (fogcl/volume_report.h); an error together with any of those flags.
   bool max_error_given = false;
   double max_error = 0;
+  // From the camera flags (cli/camera_cli.h): the renderer's axes of every world-space input here
+  // (unset: fogcl's own), and whether each frame brings its pose (set_frame_pose) instead of
+  // --eye/--forward/--up: with --camera-to-world, or from the color file's worldToCamera.
+  std::optional<Axes> axes;
+  bool pose_per_frame = false;
 };
 
 // Registers the volume flags on `fogcl apply`.
@@ -47,7 +54,9 @@ void note_given_volume_flags(const CLI::App& apply, VolumeCliOptions& o);
 // VOLUMES.json (README "VOLUMES.json"): {"volumes": [{"center": [x, y, z], "radius": r, ...}]},
 // each key a FogVolume field in snake_case. Throws fogcl::Error, one line: "NAME: volume I: 'KEY'
 // RULE (got VALUE)" for a wrong value, "NAME: ...: parse error at line L, column C: ..." for
-// malformed JSON. Every volume also passes fogcl::validate().
+// malformed JSON. Every volume also passes fogcl::validate(). One key that is not a field:
+// "medium": "homogeneous" (a plain medium: noise and fades off, albedo and ambient 0 unless given;
+// it refuses the noise and fade keys). The values are as given: VolumeStage maps them from --axes.
 std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name);
 std::vector<FogVolume> read_volumes_json(const std::string& path);
 // The inverse: every key of each volume (albedo and ambient only when set), parse_volumes_json
@@ -73,6 +82,9 @@ class VolumeStage {
   // sequence_frame: the frame number in a sequence, -1 for a single file. --frame defaults to it
   // (0 for a single file), --time to sequence_frame / --fps (0 for a single file).
   VolumeScene scene_for(int sequence_frame) const;
+  // The pose of the next frames (fogcl's world) when the options say it comes with each frame;
+  // `from` says where it came from (--verbose).
+  void set_frame_pose(const std::optional<CameraPose>& pose, const std::string& from);
   const VolumeSettings& settings() const { return settings_; }
   const ShadowMap* shadow() const { return shadow_ ? &*shadow_ : nullptr; }
 
@@ -87,6 +99,8 @@ class VolumeStage {
   VolumeCliOptions options_;
   std::vector<FogVolume> volumes_;
   CameraPose pose_;
+  std::optional<CameraPose> frame_pose_;  // options_.pose_per_frame: the current frame's
+  std::string pose_from_;
   MainLight light_;
   VolumeSettings settings_;
   std::optional<ShadowMap> shadow_;

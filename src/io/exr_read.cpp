@@ -24,6 +24,7 @@
 #include <Iex.h>
 #include <Imath/ImathBox.h>
 #include <Imath/ImathMatrix.h>
+#include <glm/geometric.hpp>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfDeepFrameBuffer.h>
 #include <OpenEXR/ImfDeepScanLineInputPart.h>
@@ -269,8 +270,11 @@ void read_deep(Source& s, int part, const Frame& f, const ExrReadRequest& r, con
 }
 
 // Derives a symmetric perspective camera from worldToCamera and worldToNDC (row vectors, as
-// Imath: p_ndc ~ p_cam * inverse(worldToCamera) * worldToNDC). With camera space looking down +z
-// and NDC (0, 0) at the top left: ndc_x = 0.5 + 0.5 x / (z tan(h/2)), ndc_y = 0.5 - 0.5 y / (z tan(v/2)).
+// Imath: p_ndc ~ p_cam * inverse(worldToCamera) * worldToNDC). OpenEXR's camera space looks down
+// +z with NDC (0, 0) at the top left: ndc_x = 0.5 + 0.5 x / (z tan(h/2)), ndc_y = 0.5 - 0.5 y /
+// (z tan(v/2)). A camera space looking down -z (w = -z) is read the same way: the viewing
+// direction is the camera axis along which w grows, and image right and up are the camera axes
+// along which ndc x grows and ndc y falls; their signs come from the matrices, not a convention.
 ExrCamera camera_of(const Imf::Header& header) {
   ExrCamera cam;
   if (!Imf::hasWorldToNDC(header) || !Imf::hasWorldToCamera(header)) return cam;
@@ -301,11 +305,11 @@ ExrCamera camera_of(const Imf::Header& header) {
   const bool centred = std::fabs(a(2, 0) - 0.5) < tol && std::fabs(a(2, 1) - 0.5) < tol &&
                        std::fabs(a(1, 0)) < tol && std::fabs(a(0, 1)) < tol && std::fabs(a(3, 0)) < tol &&
                        std::fabs(a(3, 1)) < tol;
-  if (!perspective || !centred || !(a(0, 0) > 0) || !(a(1, 1) < 0)) {
-    cam.note = "worldToNDC is not a symmetric perspective projection looking down +z";
+  if (!perspective || !centred || a(0, 0) == 0.0 || a(1, 1) == 0.0) {
+    cam.note = "worldToNDC is not a symmetric perspective projection along the camera's z axis";
     return cam;
   }
-  const double tan_h = 0.5 / a(0, 0), tan_v = -0.5 / a(1, 1);
+  const double tan_h = 0.5 / std::fabs(a(0, 0)), tan_v = 0.5 / std::fabs(a(1, 1));
   const double fov = 2.0 * std::atan(tan_v) * 180.0 / 3.14159265358979323846;
   if (!std::isfinite(fov) || !(fov > 0.0 && fov < 180.0) || !std::isfinite(tan_h / tan_v)) {
     cam.note = "worldToNDC gives no finite field of view";
@@ -314,6 +318,39 @@ ExrCamera camera_of(const Imf::Header& header) {
   cam.present = true;
   cam.fov_y_deg = float(fov);
   cam.aspect = float(tan_h / tan_v);
+
+  // The pose. Row vectors: c2w's rows 0-2 are the camera axes in the world, row 3 its position.
+  // In front of the camera w = wz * z > 0: it looks along +z when wz > 0 (OpenEXR's), along -z when
+  // wz < 0. There, a step along camera x moves ndc x by m[0][0] / w: image right is +x when
+  // m[0][0] > 0; ndc y grows downward, so image up is +y when m[1][1] < 0.
+  glm::dvec3 axis[3];
+  for (int i = 0; i < 3; ++i) axis[i] = glm::dvec3(c2w[i][0], c2w[i][1], c2w[i][2]);
+  const glm::dvec3 right = axis[0] * (m[0][0] > 0.0 ? 1.0 : -1.0);
+  const glm::dvec3 up = axis[1] * (m[1][1] < 0.0 ? 1.0 : -1.0);
+  const glm::dvec3 forward = axis[2] * (wz > 0.0 ? 1.0 : -1.0);
+  for (int i = 0; i < 3; ++i) {
+    const double len = glm::length(axis[i]);
+    if (!(std::fabs(len - 1.0) <= tol)) {
+      cam.pose_note = "worldToCamera is not rigid: camera axis " + std::to_string(i) + " has length " +
+                      std::to_string(len) + " in the world (a scale)";
+      return cam;
+    }
+  }
+  const double d01 = glm::dot(axis[0], axis[1]), d02 = glm::dot(axis[0], axis[2]), d12 = glm::dot(axis[1], axis[2]);
+  if (!(std::fabs(d01) <= tol && std::fabs(d02) <= tol && std::fabs(d12) <= tol)) {
+    cam.pose_note = "worldToCamera is not rigid: its camera axes are not orthogonal in the world (a shear)";
+    return cam;
+  }
+  if (!(std::fabs(c2w[0][3]) <= tol && std::fabs(c2w[1][3]) <= tol && std::fabs(c2w[2][3]) <= tol &&
+        std::fabs(c2w[3][3] - 1.0) <= tol)) {
+    cam.pose_note = "worldToCamera is not affine (its last column is not 0 0 0 1)";
+    return cam;
+  }
+  cam.pose_present = true;
+  cam.frame.eye = glm::vec3(float(c2w[3][0]), float(c2w[3][1]), float(c2w[3][2]));
+  cam.frame.right = glm::vec3(glm::normalize(right));
+  cam.frame.up = glm::vec3(glm::normalize(up));
+  cam.frame.forward = glm::vec3(glm::normalize(forward));
   return cam;
 }
 

@@ -9,6 +9,7 @@
 #include <glm/vec2.hpp>
 
 #include "fogcl/image.h"
+#include "fogcl/renderer_camera.h"
 
 namespace fogcl {
 
@@ -63,12 +64,21 @@ struct ExrReadRequest {
 };
 
 // A perspective camera read from the standard attributes worldToNDC and worldToCamera (OpenEXR's
-// ImfStandardAttributes.h: camera space looks down +z, NDC (0, 0) is the display window's top left).
+// ImfStandardAttributes.h: camera space is left-handed and looks down +z, x right, y up; NDC (0, 0)
+// is the display window's top left; Imath's row vectors, p_ndc ~ p_world * worldToNDC). The pose
+// is in the file's world, the renderer's (fogcl/renderer_camera.h says how it becomes fogcl's).
 struct ExrCamera {
   bool present = false;     // both matrices there and they describe a symmetric perspective
   float fov_y_deg = 0.0f;   // vertical field of view [degrees]
   float aspect = 0.0f;      // tan(horizontal half fov) / tan(vertical half fov)
   std::string note;         // why the camera is absent when the matrices exist but do not fit
+  // The pose: the camera's position and its image right, image up and viewing directions in the
+  // file's world, as worldToNDC places them on the image (also for a camera space that looks down
+  // -z, as some renderers write). Present with the camera when worldToCamera is rigid (a rotation,
+  // with a reflection for a right-handed world, and a translation; 1e-4).
+  bool pose_present = false;
+  CameraFrame frame;
+  std::string pose_note;    // why the pose is absent when the camera is present
 };
 
 struct ExrInput {
