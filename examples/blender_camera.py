@@ -3,14 +3,16 @@
 Run inside Blender, headless:
 
     blender -b scene.blend --python examples/blender_camera.py
-    blender -b scene.blend --python examples/blender_camera.py -- --camera CameraName
+    blender -b scene.blend --python examples/blender_camera.py -- --camera CameraName --frame 42
 
 The first line printed is the flags, ready to paste after `fogcl apply`:
 
     --camera-to-world m00,...,m33 --axes blender --focal-length F --sensor-width W --sensor-fit auto
     --near CLIP_START --far CLIP_END
 
-(all on one line; an orthographic camera gets --ortho-size instead of the lens). The lines after it,
+(all on one line; an orthographic camera gets --ortho-size instead of the lens). --frame N reads the
+camera at frame N (default: the scene's current frame); an animated camera needs a run per frame,
+as Blender's EXRs carry no camera attributes. The lines after it,
 starting with '#', give the render size and notes. Exit status 1 with one line on stderr for a
 camera fogcl cannot take (lens shift, non-square pixels, a panoramic camera, a missing camera).
 
@@ -57,12 +59,19 @@ def main():
     args = script_args()
     scene = bpy.context.scene
     camera = scene.camera
-    if len(args) == 2 and args[0] == "--camera":
-        camera = bpy.data.objects.get(args[1])
-        if camera is None:
-            fail("no object named '%s' in the scene" % args[1])
-    elif args:
-        fail("unknown arguments %s (expected: -- --camera NAME)" % " ".join(args))
+    while args:
+        if len(args) >= 2 and args[0] == "--camera":
+            camera = bpy.data.objects.get(args[1])
+            if camera is None:
+                fail("no object named '%s' in the scene" % args[1])
+        elif len(args) >= 2 and args[0] == "--frame":
+            try:
+                scene.frame_set(int(args[1]))
+            except ValueError:
+                fail("--frame must be an integer (got '%s')" % args[1])
+        else:
+            fail("unknown arguments '%s' (expected: -- [--camera NAME] [--frame N])" % " ".join(args))
+        args = args[2:]
     if camera is None:
         fail("the scene has no camera (scene.camera is None; name one with -- --camera NAME)")
     if camera.type != "CAMERA":
