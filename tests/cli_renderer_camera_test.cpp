@@ -235,7 +235,8 @@ TEST_F(CliRendererCamera, LensFlagsGiveTheFovOfBlendersRules) {
     float aspect;
     Lens want;
   } cases[] = {
-      {"scene.exr", "scene-depth.exr", "--focal-length 35 --sensor-width 36", 64.0f / 36.0f, {35, 36, 24, SensorFit::automatic}},
+      {"scene.exr", "scene-depth.exr", "--focal-length 35 --sensor-width 36", 64.0f / 36.0f,
+       {35, 36, 24, SensorFit::automatic}},
       {"portrait.exr", "portrait-depth.exr", "--focal-length 35 --sensor-width 36", 20.0f / 36.0f,
        {35, 36, 24, SensorFit::automatic}},
       {"portrait.exr", "portrait-depth.exr", "--focal-length 35 --sensor-width 36 --sensor-fit horizontal",
@@ -342,7 +343,8 @@ TEST_F(CliRendererCamera, PoseFromTheColorFilesWorldToCamera) {
   std::string output;
   const MainLight light = demo_light();
   const std::string common = " --device scalar --near 0.3 --far 1000 --time 2 --light-dir " + csv(light.direction) +
-                             " --light-color " + csv(light.color) + " --verbose --volumes " + in("volumes-unity.json") + " --shadow-map " + in("shadow.exr") +
+                             " --light-color " + csv(light.color) + " --verbose --volumes " + in("volumes-unity.json") +
+                             " --shadow-map " + in("shadow.exr") +
                              " --light-view-proj " + light_matrix_text(Axes::unity);
   const CliRun r = run_cli("apply --color " + in("with-camera.exr") + common + " --out " + in("from-file.exr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -394,7 +396,8 @@ TEST_F(CliRendererCamera, OneKeyMediumEqualsTheSevenKeySpelling) {
                            csv(glm::vec3(b.forward)) + " --up " + csv(glm::vec3(b.up)) + " --light-dir 0.3,1,0.2";
   const std::string sphere = R"("center": [0.5, 1.5, 2], "radius": 3, "density": 0.7)";
   const std::string seven =
-      R"("noise": false, "fade_edge": 0, "proximity_fade": 0, "fade_y": 0, "max_y": 3.4e38, "albedo": [0, 0, 0], "ambient": [0, 0, 0])";
+      R"("noise": false, "fade_edge": 0, "proximity_fade": 0, "fade_y": 0, "max_y": 3.4e38, )"
+      R"("albedo": [0, 0, 0], "ambient": [0, 0, 0])";
   const auto render = [&](const std::string& volume, const std::string& name, const std::string& integrator) {
     write_text(in(name + ".json"), "{\"volumes\": [{" + volume + "}]}");
     const CliRun r = run_cli(base + " --integrator " + integrator + " --volumes " + in(name + ".json") + " --out " +

@@ -37,8 +37,8 @@ std::string orthonormal_problem(const glm::dvec3 (&v)[3], const char* const (&na
   for (int i = 0; i < 3; ++i) {
     const double len = glm::length(v[i]);
     if (!(std::fabs(len - 1.0) <= kRigidTol))
-      return std::string(names[i]) + " " + str(v[i]) + " has length " + str(len) + " (a scale or shear): it must be 1 within " +
-             str(kRigidTol);
+      return std::string(names[i]) + " " + str(v[i]) + " has length " + str(len) +
+             " (a scale or shear): it must be 1 within " + str(kRigidTol);
   }
   for (int i = 0; i < 3; ++i)
     for (int j = i + 1; j < 3; ++j) {

@@ -71,7 +71,7 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
     camera.fov_y_deg = color.camera.fov_y_deg;
     *from = "worldToNDC";
   } else {
-    throw Error(color.path + ": no --fov given (nor --ortho-size) and the file has no usable camera (" +
+    throw Error(color.path + ": no --fov or --focal-length given (nor --ortho-size) and the file has no usable camera (" +
                 (color.camera.note.empty() ? std::string("no worldToNDC and worldToCamera attributes")
                                            : color.camera.note) +
                 ")");

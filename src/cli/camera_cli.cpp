@@ -145,7 +145,9 @@ void resolve_camera_flags(const CLI::App& app, ApplyOptions& ap) {
       camera_frame(*o.matrix, *o.axes_value);  // rigid, before any file is read
     } catch (const Error& e) {
       const std::string what = e.what();
-      throw Error(what.rfind("--camera-to-world", 0) == 0 ? what : as_flag(what, "camera-to-world matrix", "--camera-to-world"));
+      throw Error(what.rfind("--camera-to-world", 0) == 0
+                      ? what
+                      : as_flag(what, "camera-to-world matrix", "--camera-to-world"));
     }
   }
   VolumeCliOptions& v = ap.volumes;
