@@ -246,6 +246,27 @@ TEST_F(InputLimits, AHugeDisplayWindowIsRefusedBeforeItIsAllocated) {
   EXPECT_FALSE(fs::exists(path("out.exr")));
 }
 
+// The shadow map is a frame too (loaded once a run): its display window is checked the same way.
+TEST_F(InputLimits, AHugeShadowMapIsRefusedBeforeItIsAllocated) {
+  write_frame("frame.exr", box(0, 0, 15, 8), box(0, 0, 15, 8));
+  const fixtures::RenderFrame map = fixtures::make_render_frame(box(0, 0, 19999, 19999), box(0, 0, 7, 5), 3);
+  fixtures::write_flat(path("shadow.exr"), map, {{"", {fixtures::depth_channel(map, "Z")}, false, false}});
+  std::ofstream(path("v.json")) << R"({"volumes": [{"center": [0, 1, 0], "radius": 2}]})";
+  const MeasuredRun r = run_measured("apply --color " + path("frame.exr") + kFog + " --volumes " + path("v.json") +
+                                     " --eye 0,1,-5 --forward 0,0,1 --up 0,1,0 --shadow-map " + path("shadow.exr") +
+                                     " --light-view-proj 1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1 --max-memory 1G --out " +
+                                     path("out.exr"));
+  std::printf("[ shadow   ] exit %d in %.2f s, peak %.0f MiB: %s", r.exit_code, r.seconds, r.peak_mib, r.output.c_str());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.lines(), 1) << r.output;
+  EXPECT_MSG_HAS(r.output, "fogcl: error: --shadow-map: " + path("shadow.exr") +
+                               ": a 20000x20000 shadow map (display window (0, 0)-(19999, 19999)) needs about 2.98 GiB "
+                               "(the map 1.49 GiB, its device copy 1.49 GiB), more than 1.00 GiB (--max-memory 1G)");
+  EXPECT_LT(r.peak_mib, 200.0);
+  EXPECT_LT(r.seconds, 10.0);
+  EXPECT_FALSE(fs::exists(path("out.exr")));
+}
+
 // The default limit is half of the machine's memory: a 46000x46000 frame (the largest display
 // window the reader takes is 2^31 pixels) needs 70.9 GiB.
 TEST_F(InputLimits, TheDefaultLimitIsHalfTheMachinesMemory) {

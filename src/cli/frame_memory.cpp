@@ -170,6 +170,18 @@ void check_frame_memory(const std::string& path, const ExrFrameShape& shape, con
               memory_text(limit.bytes) + " (" + limit.source + ")");
 }
 
+void check_shadow_map_memory(const std::string& path, const ExrFrameShape& shape, const MemoryLimit& limit) {
+  const ExrWindows& w = shape.windows;
+  const std::uint64_t width = std::uint64_t(std::int64_t(w.display_max.x) - w.display_min.x + 1);
+  const std::uint64_t height = std::uint64_t(std::int64_t(w.display_max.y) - w.display_min.y + 1);
+  const std::uint64_t bytes = width * height * 8;
+  if (bytes <= limit.bytes) return;
+  throw Error(path + ": a " + std::to_string(width) + "x" + std::to_string(height) + " shadow map (display window " +
+              window_text(w) + ") needs about " + memory_text(bytes) + " (the map " + memory_text(bytes / 2) +
+              ", its device copy " + memory_text(bytes / 2) + "), more than " + memory_text(limit.bytes) + " (" +
+              limit.source + ")");
+}
+
 void check_device_allocations(const std::string& path, const Runtime& runtime, int width, int height,
                               ColorFormat format, const FrameMemoryNeeds& needs) {
   const cl::Device device(runtime.device(), true);

@@ -78,6 +78,10 @@ FrameMemoryPlan frame_memory(const ExrFrameShape& shape, const FrameMemoryNeeds&
 void check_frame_memory(const std::string& path, const ExrFrameShape& shape, const FrameMemoryNeeds& needs,
                         const MemoryLimit& limit);
 
+// The same for --shadow-map: "PATH: a WxH shadow map (display window ...) needs about SIZE (the map,
+// its device copy), more than LIMIT (source)"; the map costs 8 bytes a pixel, loaded once a run.
+void check_shadow_map_memory(const std::string& path, const ExrFrameShape& shape, const MemoryLimit& limit);
+
 // Throws fogcl::Error "PATH: a WxH FORMAT frame needs a SIZE NAME buffer ..." when one of the frame's device buffers
 // (color, depth, output; the volume target) is larger than the device's CL_DEVICE_MAX_MEM_ALLOC_SIZE, which the OpenCL
 // call would refuse as CL_INVALID_BUFFER_SIZE.

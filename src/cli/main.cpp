@@ -202,6 +202,7 @@ int main(int argc, char** argv) {
     ap.max_error_given = apply_cmd->count("--max-error") > 0;
     ap.volumes.max_error_given = ap.max_error_given && !ap.volumes.volumes_path.empty();
     ap.volumes.max_error = ap.max_error;
+    ap.volumes.max_memory = ap.max_memory;
     if (apply_cmd->count("--threads") > 0 && ap.threads < 1)
       throw fogcl::Error("--threads must be between 1 and 4096 (got " + std::to_string(ap.threads) + ")");
     if (apply_cmd->count("--far") == 0 && !ap.infinite_far)

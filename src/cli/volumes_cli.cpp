@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cli/frame_memory.h"
 #include "cli/usage.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/volume_report.h"
@@ -552,8 +553,11 @@ glm::mat4 parse_light_view_proj(const std::string& text) {
   return m;
 }
 
-ShadowMap read_shadow_map(const std::string& path, const glm::mat4& world_to_light_clip, bool reversed_z) {
+ShadowMap read_shadow_map(const std::string& path, const glm::mat4& world_to_light_clip, bool reversed_z,
+                          const std::string& max_memory) {
   ExrReadRequest request;
+  const MemoryLimit limit = memory_limit(max_memory);
+  request.before_allocating = [&](const ExrFrameShape& shape) { check_shadow_map_memory(path, shape, limit); };
   request.read_color = false;
   request.depth_channel = "Z";
   request.depth_single_channel_fallback = true;
@@ -653,7 +657,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     } catch (const Error& e) {
       throw Error(std::string("--light-view-proj: ") + e.what());
     }
-    s.shadow_ = read_shadow_map(o.shadow_map_path, m, o.shadow_reversed_z);
+    s.shadow_ = read_shadow_map(o.shadow_map_path, m, o.shadow_reversed_z, o.max_memory);
   }
 
   if (o.max_error_given) {

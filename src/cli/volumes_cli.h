@@ -39,6 +39,7 @@ struct VolumeCliOptions {
   // volumetric error budget (fogcl/volume_report.h); an error together with any of those flags.
   bool max_error_given = false;
   double max_error = 0;
+  std::string max_memory;  // fogcl apply's --max-memory ("": the default): the shadow map is checked against it
   // From the camera flags (cli/camera_cli.h): the renderer's axes of every world-space input here
   // (unset: fogcl's own), and whether each frame brings its pose (set_frame_pose) instead of
   // --eye/--forward/--up: with --camera-to-world, or from the color file's worldToCamera.
@@ -68,8 +69,10 @@ std::string volumes_to_json(const std::vector<FogVolume>& volumes);
 // non-finite element; invertibility is ShadowMapParams' validate().
 glm::mat4 parse_light_view_proj(const std::string& text);
 
-// The light's raw depth from channel Z of `path` (or its only channel).
-ShadowMap read_shadow_map(const std::string& path, const glm::mat4& world_to_light_clip, bool reversed_z);
+// The light's raw depth from channel Z of `path` (or its only channel). A map that needs more
+// memory than `max_memory` (--max-memory's text; "": the default) is refused before it is read.
+ShadowMap read_shadow_map(const std::string& path, const glm::mat4& world_to_light_clip, bool reversed_z,
+                          const std::string& max_memory = {});
 
 // One run's volumetric pass: the volumes, light, settings and shadow map loaded and checked once;
 // the scene of each frame (jitter index and time) derived from the frame number.
