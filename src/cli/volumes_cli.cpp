@@ -458,10 +458,11 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
                  "VOLUMES.json: {\"volumes\": [{\"center\": [x,y,z], \"radius\": r, ...}]} (README 'VOLUMES.json'); "
                  "--mode may then be left out (off: only the volumes)")
       ->group(group);
-  app.add_option("--eye", o.eye, "Camera position X,Y,Z [world units] (required with --volumes)")->group(group);
-  app.add_option("--forward", o.forward, "Camera view direction X,Y,Z, non-zero (required with --volumes)")
-      ->group(group);
-  app.add_option("--up", o.up, "Camera up X,Y,Z, not parallel to --forward (required with --volumes)")->group(group);
+  const std::string pose = " (--volumes needs the pose: these three, or --camera-to-world, or none of them to read "
+                           "the color file's worldToCamera)";
+  app.add_option("--eye", o.eye, "Camera position X,Y,Z [world units]" + pose)->group(group);
+  app.add_option("--forward", o.forward, "Camera view direction X,Y,Z, non-zero" + pose)->group(group);
+  app.add_option("--up", o.up, "Camera up X,Y,Z, not parallel to --forward" + pose)->group(group);
   app.add_option("--light-dir", o.light_dir, "Main light direction X,Y,Z, from the scene toward the light")
       ->capture_default_str()
       ->group(group);
