@@ -2,7 +2,12 @@
  *
  * Variant switches, set by the host's build_options(); a variant holds no code for a feature the
  * scene does not use:
- *   FOG_MODE          1 linear, 2 linear hard step (start == end), 3 exp, 4 exp2
+ *   FOG_MODE          1 linear, 2 linear hard step (start == end), 3 exp, 4 exp2, 5 height
+ *                     (docs/DESIGN.md §6: along the ray, from the camera pose; one pixel per
+ *                     work-item on every device, PoCL's work-group vectoriser spreads them)
+ *   FOG_HEIGHT_FALLOFF, _RGB, _START, _CUTOFF, _MAX_OPACITY, _SUN, _SUN_START  height fog's parts
+ *                     (fog_math.h FOG_HF_*): falloff k != 0, per-channel coefficients, start > 0,
+ *                     a finite cut-off, maximum opacity < 1, the sun lobe, its own start
  *   FOG_DISTANCE      distance-based fog (corner interpolation, and a sqrt but for exp2); else
  *                     depth-based
  *   FOG_SKYBOX        fog the skybox too (no sky test); else sky pixels keep f = 1
@@ -31,7 +36,7 @@
 #pragma OPENCL FP_CONTRACT OFF /* round like the scalar path: fma only where written */
 
 #ifndef FOG_MODE
-#error "FOG_MODE must be defined: 1 linear, 2 linear step, 3 exp, 4 exp2"
+#error "FOG_MODE must be defined: 1 linear, 2 linear step, 3 exp, 4 exp2, 5 height"
 #endif
 #ifndef FOG_VECTOR_WIDTH
 #define FOG_VECTOR_WIDTH 1
@@ -75,6 +80,46 @@
 #ifndef FOG_EXP2
 #define FOG_EXP2 FOG_NAME(fog_exp2_poly)
 #endif
+#if FOG_MODE == 5
+/* Height fog's parts as fog_math.h's FOG_HF_* bit mask, a compile-time constant. */
+#ifdef FOG_HEIGHT_FALLOFF
+#define FOG_HB_FALLOFF 1
+#else
+#define FOG_HB_FALLOFF 0
+#endif
+#ifdef FOG_HEIGHT_RGB
+#define FOG_HB_RGB 2
+#else
+#define FOG_HB_RGB 0
+#endif
+#ifdef FOG_HEIGHT_START
+#define FOG_HB_START 4
+#else
+#define FOG_HB_START 0
+#endif
+#ifdef FOG_HEIGHT_CUTOFF
+#define FOG_HB_CUTOFF 8
+#else
+#define FOG_HB_CUTOFF 0
+#endif
+#ifdef FOG_HEIGHT_MAX_OPACITY
+#define FOG_HB_MAX_OPACITY 16
+#else
+#define FOG_HB_MAX_OPACITY 0
+#endif
+#ifdef FOG_HEIGHT_SUN
+#define FOG_HB_SUN 32
+#else
+#define FOG_HB_SUN 0
+#endif
+#ifdef FOG_HEIGHT_SUN_START
+#define FOG_HB_SUN_START 64
+#else
+#define FOG_HB_SUN_START 0
+#endif
+#define FOG_HEIGHT_BITS (FOG_HB_FALLOFF | FOG_HB_RGB | FOG_HB_START | FOG_HB_CUTOFF | FOG_HB_MAX_OPACITY | \
+                         FOG_HB_SUN | FOG_HB_SUN_START | (FOG_USE_SKYBOX ? 128 : 0))
+#endif
 #if FOG_VECTOR_WIDTH == 16
 #define FOG_CLAMP_BY_SELECT /* CPU devices: LLVM keeps IEEE comparisons (fog_sanitize_depth) */
 #endif
@@ -106,6 +151,11 @@ typedef struct {
   float4 fog_color, bl, br, tl, tr;
   float inv_width, height;
   int stream; /* CPU path: this frame's blocks use non-temporal stores (FOG_STREAMS) */
+#if FOG_MODE == FOG_MODE_HEIGHT
+  float hp[FOG_HP_COUNT]; /* fog_math.h's FOG_HP_* block */
+  float d0;               /* eye.y - base height */
+  float4 up, light;       /* world +y and the light, in view space */
+#endif
 } FogConstants;
 
 /* Blends one pixel (index i in the frame; color RGBA at 4 * i) with its fog factor f. */
@@ -130,6 +180,42 @@ static inline void fog_blend_pixel(global const COLOR_T* color_in, global COLOR_
 #endif
 }
 
+#if FOG_MODE == FOG_MODE_HEIGHT
+/* One pixel of height fog (docs/DESIGN.md §6) at column x, row y. */
+static inline void fog_pixel(global const COLOR_T* color_in, global const float* depth,
+                             global COLOR_T* color_out, size_t i, int x, int y,
+                             const FogConstants* k) {
+  const float u = fog_pixel_u((float)x, k->inv_width), v = fog_pixel_v((float)y, k->height);
+  int sky;
+  float wy, d0, q_sun;
+  const float s_hit = fog_height_geometry(
+      depth[i], fog_bilerp(k->bl.x, k->br.x, k->tl.x, k->tr.x, u, v), fog_bilerp(k->bl.y, k->br.y, k->tl.y, k->tr.y, u, v),
+      fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v), FOG_DEPTH_KIND, FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx,
+      k->zy, k->near_plane, k->far_plane, k->up.x, k->up.y, k->up.z, k->light.x, k->light.y, k->light.z,
+      FOG_HB_SUN != 0, k->d0, &sky, &wy, &d0, &q_sun);
+#ifdef FOG_COLOR_HALF
+  const float4 c = vload_half4(i, color_in);
+#else
+  const float4 c = vload4(i, color_in);
+#endif
+  float rgb[3] = {c.x, c.y, c.z};
+  if (!fog_height_pixel(rgb, s_hit, sky, wy, d0, q_sun, k->hp, FOG_HEIGHT_BITS)) {
+#ifdef FOG_COLOR_HALF
+    /* Copy the bits: a half -> float -> half trip would quiet a signalling NaN. */
+    vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
+#else
+    vstore4(c, i, color_out);
+#endif
+    return;
+  }
+  const float4 o = (float4)(rgb[0], rgb[1], rgb[2], c.w /* alpha passes through */);
+#ifdef FOG_COLOR_HALF
+  vstore_half4_rte(o, i, color_out);
+#else
+  vstore4(o, i, color_out);
+#endif
+}
+#else
 /* One pixel at column x, row y: the GPU path and the row tails of the CPU path. */
 static inline void fog_pixel(global const COLOR_T* color_in, global const float* depth,
                              global COLOR_T* color_out, size_t i, int x, int y,
@@ -146,6 +232,7 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
                              k->k_a, k->k_b);
   fog_blend_pixel(color_in, color_out, i, f, k);
 }
+#endif
 
 #if FOG_VECTOR_WIDTH == 16
 #include "fog_cpu_blocks.h"
@@ -155,7 +242,13 @@ kernel void deferred_fog(global const COLOR_T* color_in, global const float* dep
                          global COLOR_T* color_out, int width, int height,
                          float4 zbuffer_params, float4 projection_params, float4 corner_bl,
                          float4 corner_br, float4 corner_tl, float4 corner_tr,
-                         float4 fog_params, float4 fog_color) {
+                         float4 fog_params, float4 fog_color
+#if FOG_MODE == FOG_MODE_HEIGHT
+                         , float4 height_a /* k, start, cut-off, m */, float4 height_b /* 1 - m, e, s_sun, d0 */,
+                         float4 extinction, float4 inscattering, float4 sun_color, float4 up_view,
+                         float4 light_view
+#endif
+                         ) {
   FogConstants k;
   k.zx = zbuffer_params.x;
   k.zy = zbuffer_params.y;
@@ -170,6 +263,30 @@ kernel void deferred_fog(global const COLOR_T* color_in, global const float* dep
   k.tr = corner_tr;
   k.inv_width = 1.0f / (float)width;
   k.height = (float)height;
+#if FOG_MODE == FOG_MODE_HEIGHT
+  k.hp[FOG_HP_K] = height_a.x;
+  k.hp[FOG_HP_START] = height_a.y;
+  k.hp[FOG_HP_CUTOFF] = height_a.z;
+  k.hp[FOG_HP_MAX] = height_a.w;
+  k.hp[FOG_HP_MIN_T] = height_b.x;
+  k.hp[FOG_HP_SUN_EXP] = height_b.y;
+  k.hp[FOG_HP_SUN_START] = height_b.z;
+  k.d0 = height_b.w;
+  k.hp[FOG_HP_EXT + 0] = extinction.x;
+  k.hp[FOG_HP_EXT + 1] = extinction.y;
+  k.hp[FOG_HP_EXT + 2] = extinction.z;
+  k.hp[FOG_HP_IN + 0] = inscattering.x;
+  k.hp[FOG_HP_IN + 1] = inscattering.y;
+  k.hp[FOG_HP_IN + 2] = inscattering.z;
+  k.hp[FOG_HP_FOG + 0] = fog_color.x;
+  k.hp[FOG_HP_FOG + 1] = fog_color.y;
+  k.hp[FOG_HP_FOG + 2] = fog_color.z;
+  k.hp[FOG_HP_SUN + 0] = sun_color.x;
+  k.hp[FOG_HP_SUN + 1] = sun_color.y;
+  k.hp[FOG_HP_SUN + 2] = sun_color.z;
+  k.up = up_view;
+  k.light = light_view;
+#endif
 #if FOG_VECTOR_WIDTH == 16
   k.stream = FOG_STREAMS(width, height);
 #endif

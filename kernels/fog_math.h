@@ -50,6 +50,7 @@
 #define FOG_MODE_STEP 2
 #define FOG_MODE_EXP 3
 #define FOG_MODE_EXP2 4
+#define FOG_MODE_HEIGHT 5 /* height and atmospheric fog, docs/DESIGN.md §6 */
 #define FOG_PROJECTION_PERSPECTIVE 0
 #define FOG_PROJECTION_INFINITE_FAR 1
 #define FOG_PROJECTION_ORTHOGRAPHIC 2
@@ -348,6 +349,171 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
   return f == (FOG_REAL)1 ? c
        : (f == (FOG_REAL)0 ? fog_color : FOG_NAME(fog_blend_mix)(c, fog_color, f));
 }
+
+/* ---- Height and atmospheric fog (docs/DESIGN.md §6: Unreal's exponential height fog, Filament's
+ * and Godot's height falloff, Bevy's per-channel extinction and in-scattering, a sun lobe) ----
+ * In closed form, without a branch on the value and without an epsilon. Written for the
+ * one-pixel instances (OpenCL C float, C++ float and double); the 16-pixel instance skips it. */
+#ifndef FOG_LANES16
+
+/* What a height-fog variant uses (FOG_HEIGHT_* build options; HeightCoefficients on the host):
+ * a bit mask that is a compile-time constant in the kernel, so unused parts fold away. */
+#ifndef FOG_HF_FALLOFF
+#define FOG_HF_FALLOFF 1       /* k != 0 (else H = L: no exp at all) */
+#define FOG_HF_RGB 2           /* per-channel coefficients (else one channel serves three) */
+#define FOG_HF_START 4         /* s_start > 0 */
+#define FOG_HF_CUTOFF 8        /* s_cut finite */
+#define FOG_HF_MAX_OPACITY 16  /* m < 1 */
+#define FOG_HF_SUN 32          /* the sun lobe */
+#define FOG_HF_SUN_START 64    /* the lobe's start s_sun > s_start */
+#define FOG_HF_SKYBOX 128      /* the sky is fogged, as an infinite ray (or up to s_cut) */
+/* Per-frame constants, in this order (fog_height_constants on the host). */
+#define FOG_HP_K 0           /* falloff k [1/world unit] */
+#define FOG_HP_START 1       /* s_start */
+#define FOG_HP_CUTOFF 2      /* s_cut */
+#define FOG_HP_MAX 3         /* m */
+#define FOG_HP_MIN_T 4       /* 1 - m */
+#define FOG_HP_SUN_EXP 5     /* e */
+#define FOG_HP_SUN_START 6   /* s_sun */
+#define FOG_HP_EXT 7         /* beta_ext R, G, B */
+#define FOG_HP_IN 10         /* beta_in R, G, B */
+#define FOG_HP_FOG 13        /* fog color F */
+#define FOG_HP_SUN 16        /* sun color S */
+#define FOG_HP_COUNT 19
+#endif
+
+/* G(a) = (1 - e^-a) / a for a >= 0, G(0) = 1 by a select: expm1 keeps every digit of tiny a, so
+ * no series branch is needed (Unreal's switches to a Taylor series below |x| = 0.01). */
+FOG_FN FOG_REAL FOG_NAME(fog_height_g)(FOG_REAL a) {
+  return a == (FOG_REAL)0 ? (FOG_REAL)1 : -expm1(-a) / a;
+}
+
+/* H = integral over [s0, s1] of e^(-k (h(s) - b)) ds along a ray whose height above the base is
+ * d0 + s * wy (wy = ω.y, d0 = origin height - b). H = L e^(-k (h* - b)) G(|x|), x = k wy L (the
+ * height change times k, from the direction, never a difference of heights, which cancels), h*
+ * the end where the integrand is largest: only that one is exponentiated, so nothing overflows
+ * that the true value does not. falloff == 0 (k = 0): H = L. sky_infinite (a fogged sky without a
+ * cut-off: s1 = +inf): H = e^(-k (h0 - b)) / (k wy) where k wy > 0, else +inf. */
+FOG_FN FOG_REAL FOG_NAME(fog_height_length)(FOG_REAL s0, FOG_REAL s1, FOG_REAL wy, FOG_REAL d0, FOG_REAL k,
+                                            int falloff, FOG_INT sky_infinite) {
+  FOG_REAL L = s1 - s0;
+  if (!falloff) return L;
+  FOG_REAL kwy = k * wy;
+  FOG_REAL x = kwy * L;
+  FOG_REAL e0 = fma(s0, wy, d0); /* h0 - b */
+  FOG_REAL e1 = fma(s1, wy, d0); /* h1 - b */
+  FOG_REAL top = x >= (FOG_REAL)0 ? e0 : e1;
+  FOG_REAL h = L * exp(-k * top) * FOG_NAME(fog_height_g)(fabs(x));
+  FOG_REAL h_inf = kwy > (FOG_REAL)0 ? exp(-k * e0) / kwy : (FOG_REAL)INFINITY;
+  return sky_infinite ? h_inf : h;
+}
+
+/* The optical depth beta * H with 0 * inf = 0: a zero coefficient is no fog in its channel. */
+FOG_FN FOG_REAL FOG_NAME(fog_height_depth)(FOG_REAL beta, FOG_REAL h) {
+  return beta == (FOG_REAL)0 ? (FOG_REAL)0 : beta * h;
+}
+
+/* The sun lobe max(cos θ, 0)^e from q = 1 - cos θ = |ω - ℓ|^2 / 2 (ω, ℓ unit vectors): the
+ * difference keeps the digits of small angles that a rounded cosine loses (e = 1000 near the
+ * peak), and exp(e log1p(-q)) those of the power. 0 where cos θ <= 0 (q >= 1). */
+FOG_FN FOG_REAL FOG_NAME(fog_sun_lobe)(FOG_REAL q, FOG_REAL e) {
+  return q < (FOG_REAL)1 ? exp(e * log1p(-q)) : (FOG_REAL)0;
+}
+
+/* 1 - cos(ω, ℓ) = |ω - ℓ|^2 / 2 for unit ω = (wx, wy, wz) and ℓ. */
+FOG_FN FOG_REAL FOG_NAME(fog_sun_q)(FOG_REAL wx, FOG_REAL wy, FOG_REAL wz, FOG_REAL lx, FOG_REAL ly, FOG_REAL lz) {
+  FOG_REAL dx = wx - lx, dy = wy - ly, dz = wz - lz;
+  return fma(dx, dx, fma(dy, dy, dz * dz)) * (FOG_REAL)0.5f;
+}
+
+/* One channel's output color * T + F * J + sun (sun = S λ J_sun). T == 0 contributes exactly 0,
+ * whatever the color (a hidden NaN or Inf never leaks). */
+FOG_FN FOG_REAL FOG_NAME(fog_height_blend)(FOG_REAL c, FOG_REAL t, FOG_REAL f, FOG_REAL j, FOG_REAL sun) {
+  FOG_REAL added = fma(f, j, sun);
+  return t == (FOG_REAL)0 ? added : fma(c, t, added);
+}
+
+/* The height fog of one pixel (docs/DESIGN.md §6.2) into rgb[0..2]. s_hit: distance along the ray
+ * to the surface (fog_view_distance's distance-based metric), sky: the pixel is sky, wy: ω.y,
+ * d0: the ray origin's height - b, q_sun: 1 - cos(ω, ℓ) (read with FOG_HF_SUN), p: FOG_HP_*
+ * constants, features: FOG_HF_* bits. Returns 0, leaving rgb untouched, where the pixel passes
+ * through bit for bit (sky without FOG_HF_SKYBOX, an empty segment, H = 0 and H_sun = 0). */
+FOG_FN int FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky, FOG_REAL wy, FOG_REAL d0,
+                                      FOG_REAL q_sun, const FOG_REAL* p, int features) {
+  const int rgb_channels = (features & FOG_HF_RGB) ? 3 : 1;
+  const int falloff = (features & FOG_HF_FALLOFF) != 0;
+  FOG_REAL s0 = (features & FOG_HF_START) ? p[FOG_HP_START] : (FOG_REAL)0;
+  FOG_REAL s1 = (features & FOG_HF_CUTOFF) ? fmin(s_hit, p[FOG_HP_CUTOFF]) : s_hit;
+  FOG_INT sky_infinite = 0;
+  if (features & FOG_HF_SKYBOX) {
+    /* §6.2: the sky is infinitely far in this mode, cut at s_cut where there is one. */
+    if (features & FOG_HF_CUTOFF) s1 = sky ? p[FOG_HP_CUTOFF] : s1;
+    else sky_infinite = sky;
+  } else if (sky) {
+    return 0;
+  }
+  if (!sky_infinite && !(s1 > s0)) return 0;
+  FOG_REAL k = p[FOG_HP_K];
+  FOG_REAL h = FOG_NAME(fog_height_length)(s0, s1, wy, d0, k, falloff, sky_infinite);
+  FOG_REAL h_sun = h, lobe = (FOG_REAL)0;
+  if (features & FOG_HF_SUN) {
+    lobe = FOG_NAME(fog_sun_lobe)(q_sun, p[FOG_HP_SUN_EXP]);
+    if (features & FOG_HF_SUN_START) {
+      FOG_REAL s0_sun = fmax(s0, p[FOG_HP_SUN_START]);
+      h_sun = sky_infinite || s1 > s0_sun ? FOG_NAME(fog_height_length)(s0_sun, s1, wy, d0, k, falloff, sky_infinite)
+                                          : (FOG_REAL)0;
+    }
+  }
+  if (h == (FOG_REAL)0 && h_sun == (FOG_REAL)0) return 0;
+  FOG_REAL t[3], j[3], j_sun[3];
+  for (int c = 0; c < rgb_channels; ++c) {
+    t[c] = exp(-FOG_NAME(fog_height_depth)(p[FOG_HP_EXT + c], h));
+    j[c] = -expm1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h));
+    j_sun[c] = (features & FOG_HF_SUN_START) ? -expm1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h_sun)) : j[c];
+    if (features & FOG_HF_MAX_OPACITY) {
+      t[c] = fmax(t[c], p[FOG_HP_MIN_T]);
+      j[c] = fmin(j[c], p[FOG_HP_MAX]);
+      j_sun[c] = fmin(j_sun[c], p[FOG_HP_MAX]);
+    }
+  }
+  for (int c = 0; c < 3; ++c) {
+    const int i = rgb_channels == 3 ? c : 0;
+    FOG_REAL sun = (features & FOG_HF_SUN) ? p[FOG_HP_SUN + c] * lobe * j_sun[i] : (FOG_REAL)0;
+    rgb[c] = FOG_NAME(fog_height_blend)(rgb[c], t[i], p[FOG_HP_FOG + c], j[i], sun);
+  }
+  return 1;
+}
+/* Height fog's geometry of a pixel (docs/DESIGN.md §6.1), in view space: no rotation per pixel.
+ * (cx, cy, cz): the pixel's corner ray (fog_bilerp of fog_ray_corners: at the far plane for raw
+ * depth, at view z = 1 for linear depth and the infinite far plane; orthographic: the far-plane
+ * rectangle), (ux, uy, uz): world +y in view space, (lx, ly, lz): the light in view space (read
+ * with `sun`), d0: eye.y - b. Returns s_hit, the distance along the ray from the eye (§2's
+ * distance-based metric; orthographic: eye depth from the view plane) and writes the sky flag,
+ * ω.y, the ray origin's height - b and 1 - cos(ω, ℓ). */
+FOG_FN FOG_REAL FOG_NAME(fog_height_geometry)(FOG_REAL raw, FOG_REAL cx, FOG_REAL cy, FOG_REAL cz, int kind,
+                                              int reversed_z, int projection, FOG_REAL zx, FOG_REAL zy,
+                                              FOG_REAL near_plane, FOG_REAL far_plane, FOG_REAL ux, FOG_REAL uy,
+                                              FOG_REAL uz, FOG_REAL lx, FOG_REAL ly, FOG_REAL lz, int sun,
+                                              FOG_REAL d0, FOG_INT* sky, FOG_REAL* wy, FOG_REAL* d0_pixel,
+                                              FOG_REAL* q_sun) {
+  if (projection == FOG_PROJECTION_ORTHOGRAPHIC) {
+    /* ω = forward (view +z); the ray starts on the view plane at (cx, cy, 0). */
+    *wy = uz;
+    *d0_pixel = fma(cx, ux, fma(cy, uy, d0));
+    *q_sun = sun ? FOG_NAME(fog_sun_q)((FOG_REAL)0, (FOG_REAL)0, (FOG_REAL)1, lx, ly, lz) : (FOG_REAL)0;
+    return FOG_NAME(fog_view_distance)(raw, kind == FOG_DEPTH_RAW ? far_plane : (FOG_REAL)1, kind, 1, reversed_z,
+                                       projection, 0, zx, zy, near_plane, far_plane, sky);
+  }
+  FOG_REAL len = sqrt(fma(cx, cx, fma(cy, cy, cz * cz)));
+  FOG_REAL inv = (FOG_REAL)1 / len;
+  FOG_REAL wx = cx * inv, wyv = cy * inv, wz = cz * inv;
+  *wy = fma(wx, ux, fma(wyv, uy, wz * uz));
+  *d0_pixel = d0;
+  *q_sun = sun ? FOG_NAME(fog_sun_q)(wx, wyv, wz, lx, ly, lz) : (FOG_REAL)0;
+  return FOG_NAME(fog_view_distance)(raw, len, kind, 1, reversed_z, projection, 0, zx, zy, near_plane, far_plane,
+                                     sky);
+}
+#endif /* !FOG_LANES16 */
 
 /* End of this instance: the includer's instance macros go, so the next instance can define its
  * own (FOG_EXP2 stays: it is written in terms of FOG_NAME). */

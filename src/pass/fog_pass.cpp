@@ -167,7 +167,18 @@ cl_event FogPass::Impl::dispatch(const cl::CommandQueue& queue, const FrameBuffe
   kernel->setArg(10, f4(c[kTopRight]));
   kernel->setArg(11, f4(k.a, k.b, 0.0f, 0.0f));
   kernel->setArg(12, f4(settings.color.r, settings.color.g, settings.color.b, 0.0f));
-  const int per_item = pixels_per_work_item(traits);
+  if (v.mode == KernelMode::height) {  // docs/DESIGN.md §6: the constants of fog_math.h's FOG_HP_* block
+    const detail::HeightCoefficients<float> h = detail::height_coefficients<float>(settings, camera);
+    const float* p = h.p;
+    kernel->setArg(13, f4(p[FOG_HP_K], p[FOG_HP_START], p[FOG_HP_CUTOFF], p[FOG_HP_MAX]));
+    kernel->setArg(14, f4(p[FOG_HP_MIN_T], p[FOG_HP_SUN_EXP], p[FOG_HP_SUN_START], h.d0));
+    kernel->setArg(15, f4(p[FOG_HP_EXT], p[FOG_HP_EXT + 1], p[FOG_HP_EXT + 2], 0.0f));
+    kernel->setArg(16, f4(p[FOG_HP_IN], p[FOG_HP_IN + 1], p[FOG_HP_IN + 2], 0.0f));
+    kernel->setArg(17, f4(p[FOG_HP_SUN], p[FOG_HP_SUN + 1], p[FOG_HP_SUN + 2], 0.0f));
+    kernel->setArg(18, f4(h.up[0], h.up[1], h.up[2], 0.0f));
+    kernel->setArg(19, f4(h.light[0], h.light[1], h.light[2], 0.0f));
+  }
+  const int per_item = pixels_per_work_item(traits, v);
   queue.enqueueNDRangeKernel(*kernel, cl::NullRange, cl::NDRange((fb.width + per_item - 1) / per_item, fb.height),
                              cl::NullRange, waits, &done);
   ++stats.kernel_dispatches;

@@ -12,8 +12,11 @@
 #include "fogcl/camera.h"
 
 namespace fogcl::formulas {
+using std::exp;
 using std::expm1;
+using std::fabs;
 using std::fma;
+using std::log1p;
 using std::fmax;
 using std::fmin;
 using std::isnan;

@@ -62,10 +62,53 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
   const int kind = int(v.depth_kind), sky_infinite = v.sky_infinite;
   const int needs_ray = FOG_NEEDS_RAY(distance, kind), ray_squared = FOG_RAY_SQUARED(mode, distance, kind);
   const T inv_width = T(1) / T(w);
+  // Height fog (docs/DESIGN.md §6): the FOG_HP_* constants, and for the fog factor and amount
+  // the reference reports (with_amount) two probes: T of the red channel (color 1, no fog color,
+  // no sun) and its J (color 0, fog color 1, no sun).
+  const bool height = v.mode == KernelMode::height;
+  HeightCoefficients<T> hc;
+  T probe_t[FOG_HP_COUNT], probe_j[FOG_HP_COUNT];
+  const int features = v.height_features | (v.fog_skybox ? FOG_HF_SKYBOX : 0);
+  if (height) {
+    hc = height_coefficients<T>(s, cam);
+    for (int k = 0; k < FOG_HP_COUNT; ++k) probe_t[k] = probe_j[k] = hc.p[k];
+    for (int c = 0; c < 3; ++c) {
+      probe_t[FOG_HP_FOG + c] = probe_t[FOG_HP_SUN + c] = probe_j[FOG_HP_SUN + c] = T(0);
+      probe_j[FOG_HP_FOG + c] = T(1);
+    }
+  }
   for (int y = y0; y < y1; ++y) {
     const T vv = fog_pixel_v(T(y), T(h));
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+      if (height) {
+        const T u = fog_pixel_u(T(x), inv_width);
+        T ray[3];
+        for (int k = 0; k < 3; ++k)
+          ray[k] = fog_bilerp(T(cn[kBottomLeft][k]), T(cn[kBottomRight][k]), T(cn[kTopLeft][k]), T(cn[kTopRight][k]),
+                              u, vv);
+        int sky;
+        T wy, d0, q_sun;
+        const T s_hit = fog_height_geometry(T(raw_depth[i]), ray[0], ray[1], ray[2], kind, reversed, projection, zx, zy,
+                                            near_plane, far_plane, hc.up[0], hc.up[1], hc.up[2], hc.light[0],
+                                            hc.light[1], hc.light[2], (features & FOG_HF_SUN) != 0, hc.d0, &sky, &wy,
+                                            &d0, &q_sun);
+        const Channel* c = color + 4 * i;
+        T rgba[4] = {T(load_channel(c)), T(load_channel(c + 1)), T(load_channel(c + 2)), T(load_channel(c + 3))};
+        const int fogged = fog_height_pixel(rgba, s_hit, sky, wy, d0, q_sun, hc.p, features);
+        T f = 1, amount = 0;
+        if (with_amount && fogged) {
+          T t[3] = {1, 1, 1}, j[3] = {0, 0, 0};
+          fog_height_pixel(t, s_hit, sky, wy, d0, q_sun, probe_t, features);
+          fog_height_pixel(j, s_hit, sky, wy, d0, q_sun, probe_j, features);
+          f = t[0];
+          amount = j[0];
+        } else if (fogged) {
+          f = T(0.5);  // not 1: the pixel changed (the half path copies the bits where f == 1)
+        }
+        sink(i, f, amount, rgba);
+        continue;
+      }
       const T ray = needs_ray ? fog_corner_ray_term(cn, fog_pixel_u(T(x), inv_width), vv, ray_squared) : T(0);
       T f = 1, amount = 0;
       if (v.needs_pass()) {

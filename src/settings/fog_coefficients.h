@@ -3,8 +3,15 @@
 // for the reference. The per-pixel formulas that consume them are in kernels/fog_math.h.
 #pragma once
 
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include "fogcl/camera.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/variant.h"
+#include "pass/formulas.h"
 
 namespace fogcl::detail {
 
@@ -36,7 +43,56 @@ FogCoefficients<T> fog_coefficients(const FogSettings& s, KernelMode mode) {
       c.b = T(s.density);
       break;
     case KernelMode::none:
+    case KernelMode::height:
       break;
+  }
+  return c;
+}
+
+// The per-frame constants of height fog (docs/DESIGN.md §6) in T: the FOG_HP_* block of
+// kernels/fog_math.h, and the camera in view space, so that a pixel needs no rotation: ω.y =
+// dot(ω_view, up) and cos(ω, ℓ) from ω_view and light. The rotation is computed in double and
+// rounded once to T.
+template <class T>
+struct HeightCoefficients {
+  T p[FOG_HP_COUNT] = {};
+  T d0 = 0;         // eye.y - base height
+  T up[3] = {};     // world +y in view space (R^T (0, 1, 0)); orthographic: also ω.y = up[2]
+  T light[3] = {};  // the unit direction toward the light in view space (R^T ℓ)
+};
+
+template <class T>
+HeightCoefficients<T> height_coefficients(const FogSettings& s, const CameraParams& cam) {
+  HeightCoefficients<T> c;
+  const HeightFogSettings& h = s.height;
+  const glm::vec3 ext = h.extinction.value_or(glm::vec3(s.density));
+  const glm::vec3 in = h.inscattering.value_or(ext);
+  c.p[FOG_HP_K] = T(h.falloff);
+  c.p[FOG_HP_START] = T(h.start);
+  c.p[FOG_HP_CUTOFF] = T(h.cutoff);
+  c.p[FOG_HP_MAX] = T(h.max_opacity);
+  c.p[FOG_HP_MIN_T] = T(1) - T(h.max_opacity);
+  for (int k = 0; k < 3; ++k) {
+    c.p[FOG_HP_EXT + k] = T(ext[k]);
+    c.p[FOG_HP_IN + k] = T(in[k]);
+    c.p[FOG_HP_FOG + k] = T(s.color[k]);
+  }
+  const CameraPose pose = cam.pose.value_or(CameraPose{});
+  const glm::dvec3 f = glm::normalize(glm::dvec3(pose.forward));
+  const glm::dvec3 r = glm::normalize(glm::cross(glm::dvec3(pose.up), f));
+  const glm::dvec3 u = glm::cross(f, r);
+  c.d0 = T(double(pose.eye.y) - double(h.base_height));
+  c.up[0] = T(r.y);
+  c.up[1] = T(u.y);
+  c.up[2] = T(f.y);
+  if (h.sun) {
+    c.p[FOG_HP_SUN_EXP] = T(h.sun->exponent);
+    c.p[FOG_HP_SUN_START] = T(h.sun->start);
+    for (int k = 0; k < 3; ++k) c.p[FOG_HP_SUN + k] = T(h.sun->color[k]);
+    const glm::dvec3 l = glm::normalize(glm::dvec3(h.sun->direction));
+    c.light[0] = T(glm::dot(r, l));
+    c.light[1] = T(glm::dot(u, l));
+    c.light[2] = T(glm::dot(f, l));
   }
   return c;
 }

@@ -15,12 +15,49 @@ std::string num(float v) {
   return s.str();
 }
 bool finite(float v) { return std::isfinite(v); }
+std::string num3(const glm::vec3& v) { return num(v.x) + "," + num(v.y) + "," + num(v.z); }
+bool finite_non_negative(const glm::vec3& v) {
+  for (int c = 0; c < 3; ++c)
+    if (!(finite(v[c]) && v[c] >= 0.0f)) return false;
+  return true;
+}
+
+// FogMode::height's own parameters (docs/DESIGN.md §6.1).
+void validate_height(const FogSettings& s) {
+  const HeightFogSettings& h = s.height;
+  if (!h.extinction && !(finite(s.density) && s.density >= 0.0f))
+    throw Error("height fog density must be finite and >= 0 (got " + num(s.density) + ")");
+  if (h.extinction && !finite_non_negative(*h.extinction))
+    throw Error("height fog extinction must be finite and >= 0 in each channel (got " + num3(*h.extinction) + ")");
+  if (h.inscattering && !finite_non_negative(*h.inscattering))
+    throw Error("height fog in-scattering must be finite and >= 0 in each channel (got " + num3(*h.inscattering) +
+                ")");
+  if (!finite(h.falloff)) throw Error("height fog falloff must be finite (got " + num(h.falloff) + ")");
+  if (!finite(h.base_height)) throw Error("height fog base height must be finite (got " + num(h.base_height) + ")");
+  if (!(finite(h.start) && h.start >= 0.0f))
+    throw Error("height fog start must be finite and >= 0 (got " + num(h.start) + ")");
+  if (!(h.cutoff > h.start))
+    throw Error("height fog cut-off must be > start (got cut-off " + num(h.cutoff) + ", start " + num(h.start) + ")");
+  if (!(h.max_opacity >= 0.0f && h.max_opacity <= 1.0f))
+    throw Error("height fog maximum opacity must be in [0, 1] (got " + num(h.max_opacity) + ")");
+  if (h.sun) {
+    const SunLobe& l = *h.sun;
+    if (!(finite(l.direction.x) && finite(l.direction.y) && finite(l.direction.z)) || l.direction == glm::vec3(0.0f))
+      throw Error("sun direction must be a finite non-zero vector (got " + num3(l.direction) + ")");
+    if (!finite_non_negative(l.color))
+      throw Error("sun color must be finite and >= 0 in each channel (got " + num3(l.color) + ")");
+    if (!(finite(l.exponent) && l.exponent > 0.0f))
+      throw Error("sun exponent must be finite and > 0 (got " + num(l.exponent) + ")");
+    if (!(finite(l.start) && l.start >= 0.0f))
+      throw Error("sun start must be finite and >= 0 (got " + num(l.start) + ")");
+  }
+}
 }  // namespace
 
 void validate(const FogSettings& s) {
   if (s.mode != FogMode::off && s.mode != FogMode::linear && s.mode != FogMode::exp &&
-      s.mode != FogMode::exp2)
-    throw Error("fog mode " + std::to_string(int(s.mode)) + " is not one of off, linear, exp, exp2");
+      s.mode != FogMode::exp2 && s.mode != FogMode::height)
+    throw Error("fog mode " + std::to_string(int(s.mode)) + " is not one of off, linear, exp, exp2, height");
   if (s.mode == FogMode::off) return;
   for (int c = 0; c < 3; ++c)
     if (!finite(s.color[c]) || std::fabs(s.color[c]) > 65504.0f)
@@ -31,6 +68,8 @@ void validate(const FogSettings& s) {
     if (!finite(s.end)) throw Error("fog end must be finite (got " + num(s.end) + ")");
     if (s.start > s.end)
       throw Error("fog start must be <= end (got start " + num(s.start) + ", end " + num(s.end) + ")");
+  } else if (s.mode == FogMode::height) {
+    validate_height(s);
   } else if (!(s.density >= 0.0f) || !finite(s.density)) {
     throw Error("fog density must be finite and >= 0 (got " + num(s.density) + ")");
   }
@@ -48,6 +87,7 @@ const char* to_string(FogMode mode) {
     case FogMode::linear: return "linear";
     case FogMode::exp: return "exp";
     case FogMode::exp2: return "exp2";
+    case FogMode::height: return "height";
   }
   return "?";
 }

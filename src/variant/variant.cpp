@@ -1,10 +1,12 @@
 #include "fogcl/variant.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "fogcl/error.h"
 #include "fogcl/runtime.h"
+#include "fogcl/volumes.h"
 
 namespace fogcl {
 
@@ -23,6 +25,37 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
       if (s.density == 0.0f) return v;
       v.mode = s.mode == FogMode::exp ? KernelMode::exp : KernelMode::exp2;
       break;
+    case FogMode::height: {
+      if (!camera.pose)
+        throw Error("height fog needs the camera pose (CameraParams::pose: eye, forward, up)");
+      validate(*camera.pose);
+      const HeightFogSettings& h = s.height;
+      const glm::vec3 ext = h.extinction.value_or(glm::vec3(s.density));
+      const glm::vec3 in = h.inscattering.value_or(ext);
+      // Maximum opacity 0, or no extinction and no in-scattering: T = 1 and J = 0 everywhere (the
+      // lobe scales J_sun, also 0): no pass, output = input bit for bit.
+      if (h.max_opacity == 0.0f || (ext == glm::vec3(0.0f) && in == glm::vec3(0.0f))) return v;
+      v.mode = KernelMode::height;
+      int f = 0;
+      if (h.falloff != 0.0f) f |= kHeightFalloff;
+      if (ext.x != ext.y || ext.x != ext.z || in.x != in.y || in.x != in.z) f |= kHeightRgb;
+      if (h.start > 0.0f) f |= kHeightStart;
+      if (std::isfinite(h.cutoff)) f |= kHeightCutoff;
+      if (h.max_opacity < 1.0f) f |= kHeightMaxOpacity;
+      if (h.sun && h.sun->color != glm::vec3(0.0f) && in != glm::vec3(0.0f)) {
+        f |= kHeightSun;
+        if (h.sun->start > h.start) f |= kHeightSunStart;
+      }
+      v.height_features = f;
+      // Always along the ray from the eye; the sky is an infinite ray (§6.2), never at the far plane.
+      v.projection = camera.projection;
+      v.fog_skybox = s.fog_skybox;
+      v.reversed_z = camera.reversed_z;
+      v.depth_kind = camera.depth_kind;
+      v.storage = storage;
+      v.precision = s.precision;
+      return v;
+    }
   }
   // Orthographic rays are parallel to the view axis: distance-based fog is depth-based fog, so
   // the variant carries no ray interpolation and no sqrt for it.
@@ -47,6 +80,9 @@ DeviceTraits device_traits(cl_device_id device, const CpuCodegen& codegen) {
 }
 
 int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }
+int pixels_per_work_item(const DeviceTraits& device, const Variant& variant) {
+  return variant.mode == KernelMode::height ? 1 : pixels_per_work_item(device);
+}
 
 long long streaming_min_pixels(const DeviceTraits& device) {
   if (!device.cpu) return -1;  // GPUs: one pixel per work-item, their own store paths
@@ -95,8 +131,13 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.projection != Projection::perspective) o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
-  o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
-  o += streaming_store_option(device, v.storage);
+  if (v.mode == KernelMode::height) {
+    static const char* const kNames[] = {"FALLOFF", "RGB", "START", "CUTOFF", "MAX_OPACITY", "SUN", "SUN_START"};
+    for (int bit = 0; bit < 7; ++bit)
+      if (v.height_features & (1 << bit)) o += std::string(" -D FOG_HEIGHT_") + kNames[bit];
+  }
+  o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device, v));
+  if (v.mode != KernelMode::height) o += streaming_store_option(device, v.storage);
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }
@@ -108,6 +149,7 @@ const char* to_string(KernelMode m) {
     case KernelMode::linear_step: return "linear-step";
     case KernelMode::exp: return "exp";
     case KernelMode::exp2: return "exp2";
+    case KernelMode::height: return "height";
   }
   return "?";
 }
@@ -115,7 +157,16 @@ const char* to_string(KernelMode m) {
 std::string describe(const Variant& v) {
   if (!v.needs_pass()) return "none (no pass)";
   std::string d = to_string(v.mode);
-  d += v.distance ? " distance" : " depth";
+  if (v.mode == KernelMode::height) {
+    static const char* const kNames[] = {" falloff", " rgb", " start", " cutoff", " max-opacity", " sun",
+                                         " sun-start"};
+    for (int bit = 0; bit < 7; ++bit)
+      if (v.height_features & (1 << bit)) d += kNames[bit];
+    if (!(v.height_features & kHeightFalloff)) d += " no-falloff";
+    if (!(v.height_features & kHeightRgb)) d += " grey";
+  } else {
+    d += v.distance ? " distance" : " depth";
+  }
   d += v.sky_infinite ? " sky-infinite" : v.fog_skybox ? " fog-skybox" : " sky-test";
   if (v.depth_kind == DepthKind::eye) d += " eye-depth";
   if (v.depth_kind == DepthKind::distance) d += " radial-distance";

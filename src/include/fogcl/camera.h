@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 
 #include <glm/mat4x4.hpp>
 #include <glm/vec3.hpp>
@@ -47,6 +48,15 @@ enum class DepthKind {
   distance,  // radial distance from the eye [world units] (|view-space position|); perspective only
 };
 
+// Where the camera is (docs/DESIGN.md §5.1; docs/volumetric.md §World and rays): Unity's world
+// space, left-handed, +y up. View space maps to world by the rotation with columns (right, up',
+// forward), right = normalize(cross(up, forward)), up' = cross(forward, right).
+struct CameraPose {
+  glm::vec3 eye{0.0f};                  // [world], finite
+  glm::vec3 forward{0.0f, 0.0f, 1.0f};  // view direction, non-zero (normalised by fogcl)
+  glm::vec3 up{0.0f, 1.0f, 0.0f};       // non-zero, not parallel to forward
+};
+
 // Corner order used by fogcl: bottom-left, bottom-right, top-left, top-right (index u + 2v).
 enum Corner { kBottomLeft = 0, kBottomRight = 1, kTopLeft = 2, kTopRight = 3 };
 
@@ -66,6 +76,10 @@ struct CameraParams {
   // What the depth buffer holds. Linear depth: values nearer than near are the near plane, values
   // from 0.9999 far on (and +inf, NaN, <= 0) are sky, as raw depth's clamp and sky test make them.
   DepthKind depth_kind = DepthKind::raw;
+  // The camera's pose in the world (eye, view -> world rotation): needed by the passes that work
+  // in world space, the deferred pass's height fog (FogMode::height, docs/DESIGN.md §6) among
+  // them; the other modes ignore it. The volume pass takes its pose from VolumeScene::pose.
+  std::optional<CameraPose> pose;
 
   float near_plane() const { return projection_params.y; }
   float far_plane() const { return projection_params.z; }

@@ -27,7 +27,9 @@ void apply_fog_scalar_rows(const ColorImage& in, const DepthImage& depth, ColorI
 // The fog evaluated in T (float or double), unrounded to the storage format: rgba has
 // 4 * width * height values; factor the fog factors f and amount the fog amounts 1 - f
 // (computed with expm1 for exp/exp2, so a thin fog's amount keeps its relative precision even
-// where f rounds to 1), width * height each.
+// where f rounds to 1), width * height each. Height fog (FogMode::height): factor is the red
+// channel's transmittance T and amount its fog amount J (docs/DESIGN.md §6.2); 1 and 0 where the
+// pixel passes through.
 template <class T>
 struct FogResult {
   int width = 0, height = 0;

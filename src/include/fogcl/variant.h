@@ -18,6 +18,20 @@ enum class KernelMode {
   linear_step,  // FOG_MODE=2: linear with start == end
   exp,          // FOG_MODE=3
   exp2,         // FOG_MODE=4
+  height,       // FOG_MODE=5: height and atmospheric fog (docs/DESIGN.md §6)
+};
+
+// What a height-fog variant uses (Variant::height_features; kernels/fog_math.h FOG_HF_*), each
+// a build option of its own: FOG_HEIGHT_FALLOFF, _RGB, _START, _CUTOFF, _MAX_OPACITY, _SUN,
+// _SUN_START (the sky: FOG_SKYBOX).
+enum HeightFeature : int {
+  kHeightFalloff = 1,     // k != 0
+  kHeightRgb = 2,         // per-channel coefficients (else grey: one channel computed)
+  kHeightStart = 4,       // start > 0
+  kHeightCutoff = 8,      // finite cut-off
+  kHeightMaxOpacity = 16, // maximum opacity < 1
+  kHeightSun = 32,        // the sun lobe
+  kHeightSunStart = 64,   // the lobe starts after the fog's start
 };
 
 struct Variant {
@@ -30,13 +44,14 @@ struct Variant {
   Projection projection = Projection::perspective;  // FOG_PROJECTION (1 infinite far, 2 orthographic)
   ColorFormat storage = ColorFormat::rgba32f;  // FOG_COLOR_HALF
   Precision precision = Precision::precise;    // FOG_NATIVE_MATH + -cl-fast-relaxed-math
+  int height_features = 0;  // KernelMode::height: HeightFeature bits
 
   bool needs_pass() const { return mode != KernelMode::none; }
   bool operator==(const Variant& o) const {
     return mode == o.mode && distance == o.distance && fog_skybox == o.fog_skybox &&
            reversed_z == o.reversed_z && sky_infinite == o.sky_infinite && depth_kind == o.depth_kind &&
            projection == o.projection && storage == o.storage &&
-           precision == o.precision;
+           precision == o.precision && height_features == o.height_features;
   }
 };
 
@@ -84,6 +99,9 @@ std::string streaming_store_option(const DeviceTraits& device, ColorFormat stora
 
 // Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
 int pixels_per_work_item(const DeviceTraits& device);
+// Pixels each work-item of `variant` fogs: as above, but 1 everywhere for height fog (PoCL's
+// work-group vectoriser spreads its one-pixel work-items over the SIMD lanes).
+int pixels_per_work_item(const DeviceTraits& device, const Variant& variant);
 
 // "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE ... -D FOG_VECTOR_WIDTH=16". Deterministic: equal
 // inputs give equal strings, so the string is the program cache key.

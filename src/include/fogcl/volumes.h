@@ -53,12 +53,7 @@ struct FogVolume {
   std::optional<glm::vec3> ambient;     // ambient radiance RGB >= 0; default 0.1 * light color
 };
 
-// Where the camera is (docs/volumetric.md §World and rays): Unity's world space, left-handed, +y up.
-struct CameraPose {
-  glm::vec3 eye{0.0f};                  // [world], finite
-  glm::vec3 forward{0.0f, 0.0f, 1.0f};  // view direction, non-zero (normalised by fogcl)
-  glm::vec3 up{0.0f, 1.0f, 0.0f};       // non-zero, not parallel to forward
-};
+// CameraPose (the camera's position and orientation) is in fogcl/camera.h.
 
 // The main (directional) light.
 struct MainLight {
