@@ -158,6 +158,7 @@ struct FrameJob {
   std::string camera_text;
   std::optional<CameraPose> pose;  // for the volumes, when it comes with the frame (cli/camera_cli.h)
   std::string pose_from;
+  std::string height_pose_from;  // --mode height: where the pose came from (--verbose)
   ColorImage out;      // the fogged frame
 };
 
@@ -195,6 +196,7 @@ void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullp
 
   job.params = frame_params(o, color, &job.camera_text);
   job.pose = frame_pose(o.camera, o.volumes, color, &job.pose_from);
+  job.params.pose = height_frame_pose(o, color, &job.height_pose_from);  // --mode height: the pose per frame
   validate(o.settings);
   if (kind == DepthKind::distance && job.params.projection == Projection::orthographic)
     throw Error("--depth-kind distance needs a perspective camera (an orthographic camera's rays are parallel: "
@@ -351,7 +353,7 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
       std::fprintf(stderr,
                    "  why: %s fog (--mode), %s, %s, %s projection, %s storage (the input's); what the scene "
                    "does not use is not compiled\n",
-                   to_string(variant.mode), variant.distance ? "distance-based (--distance)" : "depth-based (no sqrt)",
+                   to_string(variant.mode), variant.mode == KernelMode::height ? "along the ray (height fog: --distance changes nothing)" : variant.distance ? "distance-based (--distance)" : "depth-based (no sqrt)",
                    variant.fog_skybox ? "no sky test (--fog-skybox)" : "sky test (sky stays unfogged)",
                    params.projection == Projection::orthographic                ? "orthographic (--ortho-size)"
                    : params.projection == Projection::perspective_infinite_far ? "infinite-far (--infinite-far)"

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cli/camera_cli.h"
+#include "cli/height_cli.h"
 #include "cli/volumes_cli.h"
 #include "fogcl/fogcl.h"
 
@@ -64,6 +65,7 @@ struct ApplyOptions {
   bool verbose = false;
   VolumeCliOptions volumes;        // --volumes and its flags (cli/volumes_cli.h)
   CameraCliOptions camera;         // --camera-to-world, --axes, the lens flags (cli/camera_cli.h)
+  HeightCliOptions height;         // --mode height's flags (cli/height_cli.h)
 };
 int run_apply(const ApplyOptions& options);
 

@@ -19,7 +19,7 @@ using fogcl::Precision;
 using fogcl::SkyDistance;
 
 const std::map<std::string, FogMode> kModes{
-    {"off", FogMode::off}, {"linear", FogMode::linear}, {"exp", FogMode::exp}, {"exp2", FogMode::exp2}};
+    {"off", FogMode::off}, {"linear", FogMode::linear}, {"exp", FogMode::exp}, {"exp2", FogMode::exp2}, {"height", FogMode::height}};
 const std::map<std::string, Precision> kPrecisions{{"precise", Precision::precise}, {"fast", Precision::fast}};
 const std::map<std::string, SkyDistance> kSkies{{"far", SkyDistance::far_plane}, {"infinite", SkyDistance::infinite}};
 
@@ -130,6 +130,7 @@ int main(int argc, char** argv) {
   apply_cmd->add_flag("--verbose", ap.verbose, "Print the device, the kernel variant chosen and why");
   fogcl::cli::add_volume_options(*apply_cmd, ap.volumes);
   fogcl::cli::add_camera_options(*apply_cmd, ap.camera);
+  fogcl::cli::add_height_options(*apply_cmd, ap.height);
 
   fogcl::cli::ReportCliOptions report;
   CLI::App* report_cmd = app.add_subcommand(
@@ -195,7 +196,7 @@ int main(int argc, char** argv) {
     fogcl::cli::resolve_camera_flags(*apply_cmd, ap);
     // With volumes the deferred fog is optional: no --mode runs only the volumetric pass.
     if (apply_cmd->count("--mode") == 0) {
-      if (ap.volumes.volumes_path.empty()) throw fogcl::cli::UsageError("--mode is required (off, linear, exp or exp2)");
+      if (ap.volumes.volumes_path.empty()) throw fogcl::cli::UsageError("--mode is required (off, linear, exp, exp2 or height)");
       mode = "off";
     }
     ap.precision_given = apply_cmd->count("--precision") > 0;
@@ -222,6 +223,7 @@ int main(int argc, char** argv) {
     ap.settings.sky = kSkies.at(sky);
     ap.settings.metric = apply_cmd->count("--distance") > 0 ? FogMetric::distance : FogMetric::depth;
     if (!fog_color.empty()) ap.settings.color = glm::vec3(fog_color[0], fog_color[1], fog_color[2]);
+    fogcl::cli::resolve_height_flags(*apply_cmd, ap);
     return fogcl::cli::run_apply(ap);
   } catch (const fogcl::cli::UsageError& e) {
     std::fprintf(stderr, "fogcl: error: %s\n", e.what());
