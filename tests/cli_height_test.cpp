@@ -1,0 +1,210 @@
+// `fogcl apply --mode height` on real files: the CLI's output against the library (FogPass and the
+// scalar path) bit for bit, the volumes first, and bad input: one line naming the flag and the rule,
+// exit 1, no file left.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "fogcl/demo_scene.h"
+#include "fogcl/exr_io.h"
+#include "fogcl/volume_scalar.h"
+#include "test_support.h"
+
+namespace fogcl::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string vec3_text(const glm::vec3& v) {
+  std::ostringstream s;
+  s.precision(9);
+  s << v.x << "," << v.y << "," << v.z;
+  return s.str();
+}
+
+std::size_t differing_floats(const ColorImage& a, const ColorImage& b) {
+  if (a.size_bytes() != b.size_bytes()) return SIZE_MAX;
+  const auto* pa = static_cast<const unsigned char*>(a.data());
+  const auto* pb = static_cast<const unsigned char*>(b.data());
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size_bytes(); i += 4) n += std::memcmp(pa + i, pb + i, 4) != 0;
+  return n;
+}
+
+class CliHeight : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = temp_dir() + "/cli-height-" + std::to_string(::getpid());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    frame_ = new DemoFrame(render_demo_scene(64, 36));
+    write_exr_rgba(in("scene.exr"), frame_->color);
+    write_exr_depth(in("scene-depth.exr"), frame_->depth);
+  }
+  static void TearDownTestSuite() { delete frame_; }
+  static std::string in(const std::string& name) { return dir_ + "/" + name; }
+
+  static CameraPose pose() {
+    const DemoView view;
+    return CameraPose{view.eye, view.target - view.eye, glm::vec3(0.0f, 1.0f, 0.0f)};
+  }
+  static std::string files() {
+    return "apply --color " + in("scene.exr") + " --depth " + in("scene-depth.exr") + " --near 0.3 --far 1000 --fov 60";
+  }
+  static std::string pose_flags() {
+    const CameraPose p = pose();
+    return " --eye " + vec3_text(p.eye) + " --forward " + vec3_text(p.forward) + " --up " + vec3_text(p.up);
+  }
+  // Every part of the mode at once, as flags and as settings.
+  static constexpr const char* kFlags =
+      " --mode height --extinction 0.02,0.03,0.05 --inscattering 0.01,0.02,0.04 --height-falloff 0.4 "
+      "--base-height 0.5 --start 1 --cutoff 400 --max-opacity 0.9 --fog-color 0.6,0.7,0.8 --fog-skybox "
+      "--light-dir 0.3,0.4,1 --sun-color 1.5,1.2,0.9 --sun-exponent 20 --sun-start 2";
+  static FogSettings settings() {
+    FogSettings s;
+    s.mode = FogMode::height;
+    s.color = glm::vec3(0.6f, 0.7f, 0.8f);
+    s.fog_skybox = true;
+    HeightFogSettings& h = s.height;
+    h.extinction = glm::vec3(0.02f, 0.03f, 0.05f);
+    h.inscattering = glm::vec3(0.01f, 0.02f, 0.04f);
+    h.falloff = 0.4f;
+    h.base_height = 0.5f;
+    h.start = 1.0f;
+    h.cutoff = 400.0f;
+    h.max_opacity = 0.9f;
+    SunLobe sun;
+    sun.direction = glm::vec3(0.3f, 0.4f, 1.0f);
+    sun.color = glm::vec3(1.5f, 1.2f, 0.9f);
+    sun.exponent = 20.0f;
+    sun.start = 2.0f;
+    h.sun = sun;
+    return s;
+  }
+  static CameraParams camera() {
+    CameraParams c = frame_->params;
+    c.pose = pose();
+    return c;
+  }
+  static ColorImage run_ok(const std::string& args, const std::string& name) {
+    const std::string out = in(name);
+    fs::remove(out);
+    const CliRun r = run_cli(args + " --out " + out);
+    EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.output;
+    if (r.exit_code != 0) return ColorImage();
+    return read_exr_color(out);
+  }
+
+  static inline std::string dir_;
+  static inline DemoFrame* frame_ = nullptr;
+};
+
+TEST_F(CliHeight, EveryFlagReachesThePassBitForBit) {
+  const ColorImage scalar = run_ok(files() + pose_flags() + kFlags + " --device scalar", "scalar.exr");
+  ColorImage want;
+  apply_fog_scalar(frame_->color, frame_->depth, want, camera(), settings());
+  const std::size_t diff = differing_floats(scalar, want);
+  std::printf("[ measured ] CLI --mode height (every flag) vs apply_fog_scalar: %zu differing floats\n", diff);
+  EXPECT_EQ(diff, 0u);
+  // --distance changes nothing: height fog is along the ray.
+  EXPECT_EQ(differing_floats(run_ok(files() + pose_flags() + kFlags + " --distance --device scalar", "d.exr"), want), 0u);
+  if (runtime() != nullptr && cli_device() != "scalar") {
+    const ColorImage device = run_ok(files() + pose_flags() + kFlags + " --device " + cli_device(), "device.exr");
+    ColorImage lib;
+    shared_pass().apply(frame_->color, frame_->depth, lib, camera(), settings());
+    const std::size_t d = differing_floats(device, lib);
+    std::printf("[ measured ] CLI --mode height on --device %s vs FogPass::apply: %zu differing floats\n",
+                cli_device().c_str(), d);
+    EXPECT_EQ(d, 0u);
+  }
+  // The fog did something: the default density alone differs.
+  EXPECT_GT(differing_floats(run_ok(files() + pose_flags() + " --mode height --device scalar", "plain.exr"), want),
+            1000u);
+}
+
+TEST_F(CliHeight, VolumesFirstThenHeightFog) {
+  const std::string json = in("volumes.json");
+  std::ofstream(json) << "{\"volumes\": [{\"center\": [0, 1, 2], \"radius\": 2.5, \"density\": 0.5}]}\n";
+  const std::string fog = " --mode height --density 0.05 --height-falloff 0.5 --light-dir 0.3,0.8,-0.5";
+  const ColorImage got = run_ok(files() + pose_flags() + fog + " --volumes " + json + " --device scalar", "both.exr");
+  VolumeScene scene;
+  FogVolume v;
+  v.center = glm::vec3(0, 1, 2);
+  v.radius = 2.5f;
+  v.density = 0.5f;
+  scene.volumes = {v};
+  scene.pose = pose();
+  scene.light.direction = glm::vec3(0.3f, 0.8f, -0.5f);
+  ColorImage want;
+  apply_volumes_scalar(frame_->color, frame_->depth, want, frame_->params, scene, VolumeSettings{});
+  FogSettings s;
+  s.mode = FogMode::height;
+  s.density = 0.05f;
+  s.height.falloff = 0.5f;
+  apply_fog_scalar(want, frame_->depth, want, camera(), s);
+  EXPECT_EQ(differing_floats(got, want), 0u);
+}
+
+TEST_F(CliHeight, BadInputIsOneLineNamingTheFlagAndTheRule) {
+  const std::string p = pose_flags();
+  struct Case {
+    std::string args, part;
+  };
+  const Case cases[] = {
+      {" --mode height", "--eye is required with --mode height"},
+      {" --mode height --eye 0,1,0 --up 0,1,0", "--forward is required"},
+      {" --mode height --eye 0,1,0 --forward 0,0,0 --up 0,1,0", "--forward must be a non-zero vector"},
+      {" --mode height --eye 0,1,0 --forward 0,2,0 --up 0,1,0", "--up must not be parallel to --forward"},
+      {" --mode height --eye 0,nan,0 --forward 0,0,1 --up 0,1,0", "--eye must be finite"},
+      {p + " --mode height --density -0.1", "--density must be finite and >= 0"},
+      {p + " --mode height --density inf", "--density must be finite and >= 0"},
+      {p + " --mode height --extinction 0.1,-1,0", "--extinction must be finite and >= 0"},
+      {p + " --mode height --extinction 0.1,nan,0", "--extinction must be finite and >= 0"},
+      {p + " --mode height --inscattering inf,0,0", "--inscattering must be finite and >= 0"},
+      {p + " --mode height --height-falloff nan", "--height-falloff must be finite"},
+      {p + " --mode height --height-falloff -inf", "--height-falloff must be finite"},
+      {p + " --mode height --base-height nan", "--base-height must be finite"},
+      {p + " --mode height --max-opacity 1.01", "--max-opacity must be in [0, 1]"},
+      {p + " --mode height --max-opacity -0.5", "--max-opacity must be in [0, 1]"},
+      {p + " --mode height --start 5 --cutoff 5", "--cutoff must be > --start"},
+      {p + " --mode height --cutoff 0", "--cutoff must be > --start"},
+      {p + " --mode height --start -1", "--start must be finite and >= 0"},
+      {p + " --mode height --light-dir 0,1,0 --sun-color 1,1,1 --sun-exponent 0", "--sun-exponent must be finite and > 0"},
+      {p + " --mode height --light-dir 0,1,0 --sun-color 1,-1,1", "--sun-color must be finite and >= 0"},
+      {p + " --mode height --sun-color 1,1,1", "--sun-color needs --light-dir"},
+      {p + " --mode height --sun-start 3", "--sun-start needs --sun-color"},
+      {p + " --mode height --density 0.1 --extinction 1,1,1", "give either --density or --extinction"},
+      {" --mode exp --height-falloff 0.1", "--height-falloff needs --mode height"},
+      {" --mode linear --cutoff 10", "--cutoff needs --mode height"},
+      {" --mode exp2 --max-opacity 0.5", "--max-opacity needs --mode height"},
+      {" --mode off --sun-color 1,1,1", "--sun-color needs --mode height"},
+      {" --mode exp --extinction 1,1,1", "--extinction needs --mode height"},
+  };
+  const std::string out = in("bad.exr");
+  for (const Case& c : cases) {
+    fs::remove(out);
+    const CliRun r = run_cli(files() + c.args + " --device scalar --out " + out);
+    std::printf("[ message  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(c.part), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+}
+
+TEST_F(CliHeight, HelpDocumentsEveryHeightFlag) {
+  const CliRun r = run_cli("apply --help");
+  for (const char* flag : {"--extinction", "--inscattering", "--height-falloff", "--base-height", "--cutoff",
+                           "--max-opacity", "--sun-color", "--sun-exponent", "--sun-start", "height"})
+    EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
+}
+
+}  // namespace
+}  // namespace fogcl::test
