@@ -66,7 +66,11 @@ const DemoFrame& frame(int w, int h, ColorFormat format) {
   static std::map<std::tuple<int, int, ColorFormat>, DemoFrame> cache;
   const auto key = std::make_tuple(w, h, format);
   auto it = cache.find(key);
-  if (it == cache.end()) it = cache.emplace(key, render_demo_scene(w, h, {}, {}, format)).first;
+  if (it == cache.end()) {
+    it = cache.emplace(key, render_demo_scene(w, h, {}, {}, format)).first;
+    const DemoView view;  // height fog (modes 3, 4) needs the pose; the other modes ignore it
+    it->second.params.pose = CameraPose{view.eye, view.target - view.eye, glm::vec3(0.0f, 1.0f, 0.0f)};
+  }
   return it->second;
 }
 
@@ -152,6 +156,23 @@ Case case_of(const benchmark::State& s) {
   c.settings.density = 0.03f;
   c.settings.metric = s.range(3) ? FogMetric::distance : FogMetric::depth;
   c.settings.color = glm::vec3(0.62f, 0.68f, 0.76f);
+  // Height fog (docs/DESIGN.md §6): 3 a valley fog (grey, falloff); 4 an atmospheric haze (per
+  // channel, falloff, a sun lobe, the sky fogged as an infinite ray). dist does not apply.
+  if (s.range(2) >= 3) {
+    c.settings.mode = FogMode::height;
+    c.settings.density = 0.08f;
+    c.settings.height.falloff = 0.6f;
+    if (s.range(2) == 4) {
+      c.settings.height.extinction = glm::vec3(0.01f, 0.02f, 0.045f);
+      c.settings.height.falloff = 0.05f;
+      c.settings.fog_skybox = true;
+      SunLobe sun;
+      sun.direction = glm::vec3(0.35f, 0.3f, 1.0f);
+      sun.color = glm::vec3(1.5f, 1.2f, 0.8f);
+      sun.exponent = 12.0f;
+      c.settings.height.sun = sun;
+    }
+  }
   return c;
 }
 
@@ -275,6 +296,7 @@ void BM_Halide(benchmark::State& state) {
   const HalidePeer& peer = halide_peer();
   if (!peer.error.empty()) return state.SkipWithError(peer.error.c_str());
   const Case c = case_of(state);
+  if (c.settings.mode == FogMode::height) return state.SkipWithError("the Halide peer has no height fog");
   peer.prepare(frame(c.w, c.h, c.format).params, c.settings, c.format, kThreads);  // JIT, not timed
   timed_fog(state, "halide", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
     return host_time([&] { peer.fog(f.color, f.depth, out, f.params, s, kThreads); });
@@ -717,9 +739,10 @@ void BM_StartToFirstFrame(benchmark::State& state) {
 void FogArgs(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h", "mode", "dist", "f16"});
   for (auto [w, h] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}})
-    for (int mode : {0, 1, 2})
+    for (int mode : {0, 1, 2, 3, 4})
       for (int dist : {0, 1})
-        for (int f16 : {0, 1}) b->Args({w, h, mode, dist, f16});
+        for (int f16 : {0, 1})
+          if (mode < 3 || dist == 0) b->Args({w, h, mode, dist, f16});
   b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
 }
 
@@ -728,10 +751,12 @@ void FogArgs(benchmark::internal::Benchmark* b) {
 void DeviceArgs(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h", "mode", "dist", "f16", "nt"});
   for (auto [w, h] : {std::pair{1280, 720}, std::pair{1920, 1080}, std::pair{3840, 2160}})
-    for (int mode : {0, 1, 2})
+    for (int mode : {0, 1, 2, 3, 4})
       for (int dist : {0, 1}) {
+        if (mode >= 3 && dist == 1) continue;  // height fog: along the ray always
         for (int f16 : {0, 1}) b->Args({w, h, mode, dist, f16, 2});
-        for (int nt : {0, 1}) b->Args({w, h, mode, dist, 0, nt});
+        if (mode < 3)  // the height kernel has no non-temporal store path
+          for (int nt : {0, 1}) b->Args({w, h, mode, dist, 0, nt});
       }
   b->UseManualTime()->Unit(benchmark::kMillisecond)->MinTime(0.2);
 }

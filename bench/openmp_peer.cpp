@@ -62,6 +62,65 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
   }
 }
 
+// Height fog (docs/DESIGN.md §6): the same formulas per pixel, kFeatures (fog_math.h FOG_HF_*) a
+// compile-time constant as in the kernel (-1: `runtime_features`, for scenes the benchmark does not
+// time); one loop over the row (the channels are not separable).
+template <int kFeatures, class Channel>
+void run_height(const Channel* in, const float* depth, Channel* out, int w, int h, const CameraParams& cam,
+                const detail::HeightCoefficients<float>& k, int threads, int runtime_features = 0) {
+  using namespace formulas;
+  const int features = kFeatures >= 0 ? kFeatures : runtime_features;
+  const float zx = cam.zbuffer_params.x, zy = cam.zbuffer_params.y;
+  const float near_plane = cam.near_plane(), far_plane = cam.far_plane();
+  const auto c = fog_ray_corners(cam);
+  const int projection = int(cam.projection), reversed = cam.reversed_z, kind = int(cam.depth_kind);
+  const float inv_width = 1.0f / float(w);
+#pragma omp parallel for schedule(static) num_threads(threads)
+  for (int y = 0; y < h; ++y) {
+    const float vv = fog_pixel_v(float(y), float(h));
+    const float* d = depth + std::size_t(y) * std::size_t(w);
+    const Channel* ci = in + 4 * std::size_t(y) * std::size_t(w);
+    Channel* co = out + 4 * std::size_t(y) * std::size_t(w);
+#pragma omp simd
+    for (int x = 0; x < w; ++x) {
+      const float u = fog_pixel_u(float(x), inv_width);
+      float ray[3];
+      for (int j = 0; j < 3; ++j)
+        ray[j] = fog_bilerp(c[kBottomLeft][j], c[kBottomRight][j], c[kTopLeft][j], c[kTopRight][j], u, vv);
+      int sky;
+      float wy, d0, q;
+      const float s_hit = fog_height_geometry(d[x], ray[0], ray[1], ray[2], kind, reversed, projection, zx, zy,
+                                              near_plane, far_plane, k.up[0], k.up[1], k.up[2], k.light[0],
+                                              k.light[1], k.light[2], (features & FOG_HF_SUN) != 0, k.d0, &sky, &wy,
+                                              &d0, &q);
+      float rgb[3] = {load(ci + 4 * x), load(ci + 4 * x + 1), load(ci + 4 * x + 2)};
+      if (fog_height_pixel(rgb, s_hit, sky, wy, d0, q, k.p, features)) {
+        store(co + 4 * x + 0, rgb[0]);
+        store(co + 4 * x + 1, rgb[1]);
+        store(co + 4 * x + 2, rgb[2]);
+      } else {
+        co[4 * x + 0] = ci[4 * x + 0];
+        co[4 * x + 1] = ci[4 * x + 1];
+        co[4 * x + 2] = ci[4 * x + 2];
+      }
+      co[4 * x + 3] = ci[4 * x + 3];
+    }
+  }
+}
+
+template <class Channel>
+void dispatch_height(const Channel* in, const float* depth, Channel* out, int w, int h, const CameraParams& cam,
+                     const Variant& v, const FogSettings& s, int threads) {
+  const auto k = detail::height_coefficients<float>(s, cam);
+  const int features = v.height_features | (v.fog_skybox ? FOG_HF_SKYBOX : 0);
+  // The benchmark's two scenes as constants (fog_bench.cpp case_of, modes 3 and 4).
+  constexpr int kValley = FOG_HF_FALLOFF;
+  constexpr int kHaze = FOG_HF_FALLOFF | FOG_HF_RGB | FOG_HF_SUN | FOG_HF_SKYBOX;
+  if (features == kValley) return run_height<kValley>(in, depth, out, w, h, cam, k, threads);
+  if (features == kHaze) return run_height<kHaze>(in, depth, out, w, h, cam, k, threads);
+  run_height<-1>(in, depth, out, w, h, cam, k, threads, features);
+}
+
 template <class Channel>
 void dispatch(const Channel* in, const float* depth, Channel* out, int w, int h, const CameraParams& cam,
               const Variant& v, const detail::FogCoefficients<float>& k, const glm::vec3& fog, int threads) {
@@ -85,6 +144,7 @@ void dispatch(const Channel* in, const float* depth, Channel* out, int w, int h,
     case KernelMode::linear_step: return with_mode(std::integral_constant<int, 2>{});
     case KernelMode::exp: return with_mode(std::integral_constant<int, 3>{});
     case KernelMode::exp2: return with_mode(std::integral_constant<int, 4>{});
+    case KernelMode::height:  // dispatch_height
     case KernelMode::none: return;
   }
 }
@@ -94,6 +154,13 @@ void dispatch(const Channel* in, const float* depth, Channel* out, int w, int h,
 void FOGCL_PEER_NAME(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                      const CameraParams& camera, const FogSettings& settings, int threads) {
   const Variant v = select_variant(settings, camera, in.format());
+  if (v.mode == KernelMode::height) {
+    if (in.format() == ColorFormat::rgba32f)
+      dispatch_height(in.rgba32f(), depth.data(), out.rgba32f(), in.width(), in.height(), camera, v, settings, threads);
+    else
+      dispatch_height(in.rgba16f(), depth.data(), out.rgba16f(), in.width(), in.height(), camera, v, settings, threads);
+    return;
+  }
   const auto k = detail::fog_coefficients<float>(settings, v.mode);
   if (in.format() == ColorFormat::rgba32f)
     dispatch(in.rgba32f(), depth.data(), out.rgba32f(), in.width(), in.height(), camera, v, k, settings.color, threads);
