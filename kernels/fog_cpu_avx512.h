@@ -10,7 +10,7 @@
  * __builtin_shufflevector is a language builtin (no target needed): PoCL 5.0 (Ubuntu 24.04)
  * lowers OpenCL's shuffle / shuffle2 to a call of an out-of-line library routine that reads the
  * mask at run time, four of them per 16-pixel block, which made the deferred kernel 5-12x slower
- * on the 16-core Xeon (README, "Streaming stores, and PoCL 5's shuffle call"); PoCL 3.1
+ * on the 16-core Xeon (docs/performance.md#the-deferred-block-path, "Constant shuffles"); PoCL 3.1
  * inlined them. */
 #ifdef __clang__
 #define FOG_SHUFFLE(a, b, ...) __builtin_shufflevector((a), (b), __VA_ARGS__)

@@ -215,7 +215,7 @@ FogVolume parse_volume(const json& j, const KeyReader& r) {
         if (d < best_d) best = f.first, best_d = d;
       }
       throw Error(r.where + "unknown key '" + key_text(key) + "' (" + (best.empty() ? "" : "did you mean '" + best + "'? ") +
-                  "the keys are FogVolume's fields in snake_case, README 'VOLUMES.json')");
+                  "the keys are FogVolume's fields in snake_case: docs/cli.md#volumesjson)");
     }
     std::visit(
         [&](auto member) {
@@ -455,7 +455,7 @@ bool given(const VolumeCliOptions& o, const std::string& flag) {
 void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
   const char* group = "Volumetric fog volumes (docs/volumetric.md; run before the deferred fog)";
   app.add_option("--volumes", o.volumes_path,
-                 "VOLUMES.json: {\"volumes\": [{\"center\": [x,y,z], \"radius\": r, ...}]} (README 'VOLUMES.json'); "
+                 "VOLUMES.json: {\"volumes\": [{\"center\": [x,y,z], \"radius\": r, ...}]} (docs/cli.md#volumesjson); "
                  "--mode may then be left out (off: only the volumes)")
       ->group(group);
   const std::string pose = " (--volumes needs the pose: these three, or --camera-to-world, or none of them to read "

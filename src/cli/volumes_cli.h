@@ -52,7 +52,7 @@ void add_volume_options(CLI::App& apply, VolumeCliOptions& o);
 // After parsing: records which volume flags were given (their defaults depend on it).
 void note_given_volume_flags(const CLI::App& apply, VolumeCliOptions& o);
 
-// VOLUMES.json (README "VOLUMES.json"): {"volumes": [{"center": [x, y, z], "radius": r, ...}]},
+// VOLUMES.json (docs/cli.md#volumesjson): {"volumes": [{"center": [x, y, z], "radius": r, ...}]},
 // each key a FogVolume field in snake_case. Throws fogcl::Error, one line: "NAME: volume I: 'KEY'
 // RULE (got VALUE)" for a wrong value, "NAME: ...: parse error at line L, column C: ..." for
 // malformed JSON. Every volume also passes fogcl::validate(). One key that is not a field:

@@ -1,6 +1,6 @@
 // Reading what renderers write: multi-part files, layered channel names, deep scanline parts,
 // HALF or FLOAT channels, data windows inside the display window, and the camera standard
-// attributes (README "Renderer EXR files"; docs/DESIGN.md §2: the display window is the frame).
+// attributes (docs/cli.md#renderer-exr-files; docs/DESIGN.md §2: the display window is the frame).
 //
 // Everything goes through one Imf::MultiPartInputFile opened on an Imf::IStream: a file on disk
 // for the CLI, bytes in memory for the fuzz target, so that the fuzzer runs exactly the code the

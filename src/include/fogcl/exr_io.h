@@ -25,7 +25,7 @@ struct ExrWindows {
 
 // ---- Renderer output: layers, multi-part files, deep files, camera attributes ----------------
 //
-// What fogcl reads from a renderer's EXR (README "Renderer EXR files"):
+// What fogcl reads from a renderer's EXR (docs/cli.md#renderer-exr-files):
 //  - color: the channels LAYER.R, LAYER.G, LAYER.B (LAYER.A optional, 1 when missing) of the
 //    first part that has them; LAYER "" is the unnamed layer (R, G, B, A). HALF or FLOAT; UINT
 //    and subsampled color/depth channels are rejected.

@@ -69,7 +69,7 @@ struct CpuCodegen {
   // pass finds them in cache. The kernel reads the frame size, so one program serves every size.
   // On the 2-core EPYC (PoCL 3.1, 2 threads) streaming took 0.78-0.92x the time at 720p,
   // 0.69-0.81x at 1080p and 0.73-0.77x at 4K; on the 16-core Xeon VM (PoCL 5.0) 0.66x at 1080p
-  // (README, "Streaming stores, and PoCL 5's shuffle call"). always / never: for the benchmark's
+  // (docs/performance.md#streaming-stores). always / never: for the benchmark's
   // A/B and the tests.
   enum class Streaming { by_frame_size, always, never };
   Streaming streaming_stores = Streaming::by_frame_size;
