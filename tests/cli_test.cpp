@@ -125,17 +125,44 @@ TEST_F(Cli, BadInputExitsNonZeroWithOneLineAndNoFile) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// Whether `help` lists `flag` as an option: a line "  --flag ..." or "  -x,--flag ...", so that
+// "--up" is not found in "--upsample" or in another option's description.
+bool lists_option(const std::string& help, const std::string& flag) {
+  std::size_t line = 0;
+  while (line < help.size()) {
+    std::size_t end = help.find('\n', line);
+    if (end == std::string::npos) end = help.size();
+    std::size_t i = help.find_first_not_of(' ', line);
+    if (i < end && help[i] == '-' && i + 1 < end && help[i + 1] != '-') {  // "-h,--help"
+      const std::size_t comma = help.find(',', i);
+      i = comma < end ? comma + 1 : end;
+    }
+    if (i < end && help.compare(i, flag.size(), flag) == 0 &&
+        (i + flag.size() == end || help[i + flag.size()] == ' '))
+      return true;
+    line = end + 1;
+  }
+  return false;
+}
+
 TEST_F(Cli, HelpDocumentsEveryFlag) {
   const CliRun r = run_cli("apply --help");
   EXPECT_EQ(r.exit_code, 0);
+  EXPECT_FALSE(lists_option(r.output, "--upsam")) << "lists_option must match whole flags only (--upsample)";
   for (const char* flag : {"--color", "--depth", "--out", "--near", "--far", "--fov", "--aspect", "--reversed-z",
                            "--mode", "--start", "--end", "--density", "--fog-color", "--distance",
                            "--fog-skybox", "--device", "--layer", "--depth-channel", "--depth-kind", "--rgba-only",
-                           "--png", "--frames", "--keep-going", "--threads", "--pixel-type", "--compression"})
-    EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
+                           "--png", "--frames", "--keep-going", "--threads", "--pixel-type", "--compression",
+                           "--ortho-size", "--infinite-far", "--sky", "--precision", "--max-error", "--verbose",
+                           "--max-memory", "--camera-to-world", "--axes", "--focal-length", "--sensor-width",
+                           "--sensor-height", "--sensor-fit", "--volumes", "--eye", "--forward", "--up",
+                           "--light-dir", "--light-color", "--time", "--frame", "--fps", "--integrator", "--steps",
+                           "--volume-resolution", "--upsample", "--noise-size", "--noise-seed", "--noise-sampling",
+                           "--shadow-map", "--light-view-proj", "--shadow-reversed-z", "--help"})
+    EXPECT_TRUE(lists_option(r.output, flag)) << flag << " is not an option line of fogcl apply --help";
   const CliRun d = run_cli("demo --help");
   for (const char* flag : {"--out", "--width", "--height", "--device"})
-    EXPECT_NE(d.output.find(flag), std::string::npos) << flag;
+    EXPECT_TRUE(lists_option(d.output, flag)) << flag << " is not an option line of fogcl demo --help";
 }
 
 }  // namespace
