@@ -188,7 +188,7 @@ TEST_F(IntegrationApi, RejectsBuffersOfTheWrongSizeAndBadSizes) {
   EXPECT_EQ(pass.stats().kernel_dispatches, 0u);
 }
 
-// The case: an RGBA16F frame on buffers sized for RGBA32F (and the reverse) is refused,
+// A frame on the wrong buffers: an RGBA16F frame on buffers sized for RGBA32F (and the reverse) is refused,
 // and the message says which format the buffer's size fits.
 TEST_F(IntegrationApi, RejectsAFormatThatDoesNotMatchTheBuffers) {
   FogPass pass(ctx(), device());

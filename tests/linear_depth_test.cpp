@@ -30,7 +30,7 @@ CameraParams camera_params(float near_plane, bool reversed, DepthKind kind) {
   return p;
 }
 
-// A frame of linear depth: eye depths log-uniform in [0.5, 900] (the synthetic frame;
+// A frame of linear depth: eye depths log-uniform in [0.5, 900] (an offline render's range;
 // radial distance: the same eye depths along each pixel's ray), and a first row of background
 // and out-of-range values.
 DepthImage linear_frame(int w, int h, DepthKind kind, const CameraParams& unit_params) {

@@ -1,5 +1,5 @@
 // Error against run time (fogcl report), the error budget that picks the precision variant, and
-// the CLI flags of issue 5 (--ortho-size, --infinite-far, --max-error) end to end on the demo's
+// the camera and budget CLI flags (--ortho-size, --infinite-far, --max-error) end to end on the demo's
 // EXR files, compared against the library's double path. Tiny frames keep it fast.
 #include <array>
 #include <cstdio>
@@ -173,7 +173,7 @@ TEST(ErrorBudget, PicksTheFastestCachesAndRefusesTheImpossible) {
 // --- CLI ---------------------------------------------------------------------------------------
 
 
-class CliIssue5 : public ::testing::Test {
+class CliCameraAndBudgetFlags : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = fresh_dir("cli5");
@@ -218,7 +218,7 @@ FogSettings exp_fog() {
 }
 const char* kExpFog = " --mode exp --density 0.02 --distance --fog-color 0.6,0.7,0.8";
 
-TEST_F(CliIssue5, OrthoSizeReplacesFov) {
+TEST_F(CliCameraAndBudgetFlags, OrthoSizeReplacesFov) {
   OrthographicCamera cam;
   cam.ortho_size = 5.0f;
   cam.aspect = 48.0f / 27.0f;
@@ -231,7 +231,7 @@ TEST_F(CliIssue5, OrthoSizeReplacesFov) {
               "scene-revz-depth.exr", make_camera_params(cam), exp_fog(), "orthographic, size 5");
 }
 
-TEST_F(CliIssue5, InfiniteFarImpliesReversedZAndIgnoresFar) {
+TEST_F(CliCameraAndBudgetFlags, InfiniteFarImpliesReversedZAndIgnoresFar) {
   PerspectiveCamera cam;
   cam.aspect = 48.0f / 27.0f;
   cam.reversed_z = cam.infinite_far = true;
@@ -243,7 +243,7 @@ TEST_F(CliIssue5, InfiniteFarImpliesReversedZAndIgnoresFar) {
               "scene-revz-depth.exr", make_camera_params(cam), exp_fog(), "far infinite");
 }
 
-TEST_F(CliIssue5, CameraFlagConflictsAreClearErrors) {
+TEST_F(CliCameraAndBudgetFlags, CameraFlagConflictsAreClearErrors) {
   const std::string base = "apply --color " + in("scene.exr") + " --depth " + in("scene-depth.exr") +
                            " --device scalar --mode exp --out " + in("bad.exr");
   const struct {
@@ -267,7 +267,7 @@ TEST_F(CliIssue5, CameraFlagConflictsAreClearErrors) {
   }
 }
 
-TEST_F(CliIssue5, MaxErrorPicksTheVariantFromTheCache) {
+TEST_F(CliCameraAndBudgetFlags, MaxErrorPicksTheVariantFromTheCache) {
   FOGCL_REQUIRE_DEVICE();
   // Measure once through the API into the cache the CLI will read ($XDG_CACHE_HOME/fogcl).
   const std::string xdg = fresh_dir("xdg");

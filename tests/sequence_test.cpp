@@ -1,4 +1,4 @@
-// `fogcl apply` on sequences (issue 15): the bounded pipeline (order, failures, frames in flight,
+// `fogcl apply` on sequences: the bounded pipeline (order, failures, frames in flight,
 // interrupts), the progress bar's rate and ETA, --pixel-type / --compression / --threads, and
 // outputs that a killed run (SIGKILL mid-write, SIGINT) never leaves partial or as temporaries.
 #include <fcntl.h>

@@ -97,7 +97,7 @@ TEST(UnityConstants, FactoryRejectsWhatUnityCannotHaveGiven) {
   EXPECT_MSG_HAS(msg, "far 500");
 }
 
-// ---- validate(CameraParams): each inconsistency the issue found, and its message -------------
+// ---- validate(CameraParams): each inconsistency that once passed silently, and its message -------------
 
 class ValidateParams : public ::testing::Test {
  protected:
@@ -111,7 +111,7 @@ class ValidateParams : public ::testing::Test {
 
 TEST_F(ValidateParams, ReversedZValuesWithReversedZFalse) {
   CameraParams p = reversed;
-  p.reversed_z = false;  // the issue: returned the unfogged input without a word
+  p.reversed_z = false;  // once returned the unfogged input without a word
   const std::string msg = error_of([&] { validate(p); });
   std::printf("[ info     ] %s\n", msg.c_str());
   EXPECT_MSG_HAS(msg, "_ZBufferParams");
@@ -158,7 +158,7 @@ TEST_F(ValidateParams, CornersNotARectangle) {
 
 TEST_F(ValidateParams, FlippedProjection) {
   CameraParams p = conventional;
-  p.projection_params.x = -1.0f;  // the issue: ignored
+  p.projection_params.x = -1.0f;  // once ignored
   const std::string msg = error_of([&] { validate(p); });
   EXPECT_MSG_HAS(msg, "_ProjectionParams.x = -1");
   EXPECT_MSG_HAS(msg, "flip the rows");

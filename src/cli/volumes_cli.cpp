@@ -228,7 +228,7 @@ FogVolume parse_volume(const json& j, const KeyReader& r) {
         },
         field->second);
   }
-  // The sign rules the issue names first, in the file's words; then every range of the library.
+  // The sign rules users hit first, in the file's words; then every range of the library.
   if (!(v.radius > 0.0f)) r.fail("radius", "must be > 0", shown(j["radius"]));
   if (v.density < 0.0f) r.fail("density", "must be >= 0", shown(j["density"]));
   return v;

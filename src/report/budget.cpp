@@ -1,4 +1,4 @@
-// The error budget (issue 5 §2): the fastest precision variant whose measured worst color error on
+// The error budget (docs/accuracy.md): the fastest precision variant whose measured worst color error on
 // the report's scenes meets a maximum, measured once per (device, driver, library version + kernel digest) and
 // cached as a small CSV file under $XDG_CACHE_HOME/fogcl.
 #include <unistd.h>

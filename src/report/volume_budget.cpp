@@ -1,4 +1,4 @@
-// The volumetric error budget (issue 12): the fastest quality variant (steps, resolution,
+// The volumetric error budget: the fastest quality variant (steps, resolution,
 // upsampling, noise sampling) whose measured worst color error on the volume report's scenes meets
 // a maximum, measured once per (device, driver, library version + kernel digest, integrator, storage) and cached as
 // a small CSV file under $XDG_CACHE_HOME/fogcl, like the deferred pass's (budget.cpp).

@@ -1,4 +1,4 @@
-// Error against run time (docs/DESIGN.md §4, issue 5): every precision variant x color storage on a set
+// Error against run time (docs/DESIGN.md §4, docs/accuracy.md): every precision variant x color storage on a set
 // of scenes, each measured against the float64 path; and the error budget that picks the fastest
 // precision variant meeting a maximum error, measured once per device and library version.
 #pragma once

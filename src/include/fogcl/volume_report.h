@@ -1,4 +1,4 @@
-// Error against run time of the volumetric pass (issue 12; docs/volumetric.md §Error against run
+// Error against run time of the volumetric pass (docs/volumetric.md §Error against run
 // time): every variant of steps x resolution x upsampling x noise sampling x integrator x color
 // storage on four scenes, each measured against the scalar<double> march at 4096 steps, full
 // resolution, no jitter; and the error budget that picks the fastest variant meeting a maximum
