@@ -18,8 +18,12 @@
 #ifndef FOG_FN
 #ifdef __OPENCL_C_VERSION__
 #define FOG_FN static inline
+/* Height fog's functions are always inlined: PoCL inlines nothing else after clang's -O2, and a
+ * call left in the work-item loop keeps its vectoriser from spreading the loop over SIMD lanes. */
+#define FOG_FN_INLINE static inline __attribute__((always_inline))
 #else
 #define FOG_FN template <typename FOG_REAL> inline
+#define FOG_FN_INLINE template <typename FOG_REAL> [[gnu::always_inline]] inline
 #endif
 #endif
 
@@ -29,6 +33,7 @@
 #define FOG_REAL float16
 #define FOG_INT int16
 #define FOG_AS_UINT as_uint16
+#define FOG_AS_INT as_int16
 #define FOG_TRUNC_INT convert_int16
 #define FOG_TO_REAL convert_float16
 #define FOG_AS_REAL as_float16
@@ -37,6 +42,7 @@
 #define FOG_REAL float
 #define FOG_INT int
 #define FOG_AS_UINT as_uint
+#define FOG_AS_INT as_int
 #define FOG_TRUNC_INT convert_int
 #define FOG_TO_REAL convert_float
 #define FOG_AS_REAL as_float
@@ -382,10 +388,80 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
 #define FOG_HP_COUNT 19
 #endif
 
+/* exp, expm1 and log1p of height fog, as branch-free polynomials for every float path (inlined, so
+ * that PoCL's work-group vectoriser spreads them over SIMD lanes: a library call blocks it, and it
+ * costs 20-30x the pass's time at 1080p), the C library's for the double reference. The includer
+ * reaches them through FOG_EXP, FOG_EXPM1 and FOG_LOG1P (OpenCL: these, by default) and defines
+ * FOG_AS_INT (bit cast to FOG_INT) besides fog_exp2_poly's macros. */
+/* e^r - 1 for |r| <= ln2/2 (+ a rounding): Taylor to r^8 / 8!, truncation 5e-10 relative. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_expm1_reduced)(FOG_REAL r) {
+  FOG_REAL p = (FOG_REAL)0x1.a01a02p-16f;
+  p = fma(p, r, (FOG_REAL)0x1.a01a02p-13f);
+  p = fma(p, r, (FOG_REAL)0x1.6c16c2p-10f);
+  p = fma(p, r, (FOG_REAL)0x1.111112p-7f);
+  p = fma(p, r, (FOG_REAL)0x1.555556p-5f);
+  p = fma(p, r, (FOG_REAL)0x1.555556p-3f);
+  p = fma(p, r, (FOG_REAL)0.5f);
+  return fma(r * r, p, r);
+}
+/* x = n ln2 + r, |r| <= ln2/2: n = floor(x log2(e) + 1/2), r with ln2 in two parts (Cody-Waite). */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_ln2_reduce)(FOG_REAL x, FOG_REAL* n) {
+  *n = floor(fma(x, (FOG_REAL)0x1.715476p+0f, (FOG_REAL)0.5f));
+  return fma(-*n, (FOG_REAL)0x1.7f7d1cp-20f, fma(-*n, (FOG_REAL)0x1.62e4p-1f, x));
+}
+/* 2^n for an integral n in [-126, 127]. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_pow2i)(FOG_REAL n) { return FOG_AS_REAL((FOG_TRUNC_INT(n) + 127) << 23); }
+/* e^x for every x: within about 1 ulp; +inf above 88.72, 0 below -103.97 (no denormal results
+ * below 2^-126 but those 2^n (1 + em) keeps). */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_poly)(FOG_REAL x) {
+  FOG_REAL xc = fmin(fmax(x, (FOG_REAL)-104.0f), (FOG_REAL)89.0f), n;
+  FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(xc, &n));
+  /* 2^n in two factors: n in [-150, 129] has no single float scale. */
+  FOG_REAL n1 = floor(n * (FOG_REAL)0.5f);
+  FOG_REAL e = ((FOG_REAL)1 + em) * FOG_NAME(fog_pow2i)(n1) * FOG_NAME(fog_pow2i)(n - n1);
+  return x > (FOG_REAL)0x1.62e42ep+6f ? (FOG_REAL)INFINITY : (x < (FOG_REAL)-103.972f ? (FOG_REAL)0 : e);
+}
+/* e^x - 1 for x <= 0 (height fog's only arguments): relative error about 1 ulp, exactly -1 from
+ * x = -30 on (the true value rounds to it from -17.4); NaN never comes in. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_expm1_neg_poly)(FOG_REAL x) {
+  FOG_REAL n;
+  FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(fmax(x, (FOG_REAL)-30.0f), &n));
+  FOG_REAL s = FOG_NAME(fog_pow2i)(n);
+  return fma(s, em, s - (FOG_REAL)1); /* n = 0: em itself */
+}
+/* log(1 + y) for -1 < y <= 0 (the sun lobe's log(cos θ) from y = -(1 - cos θ)): u = 1 + y,
+ * log1p(y) = log(u) y / (u - 1) (exact in u - 1, Goldberg's correction of u's rounding), log(u) from
+ * u = m 2^k, m in [sqrt(1/2), sqrt(2)), log(m) = 2 atanh(s), s = (m - 1) / (m + 1), to s^9. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_log1p_neg_poly)(FOG_REAL y) {
+  FOG_REAL u = (FOG_REAL)1 + y;
+  FOG_INT bits = FOG_AS_INT(u);
+  FOG_REAL k = FOG_TO_REAL(((bits >> 23) & 0xff) - 127);
+  FOG_REAL m = FOG_AS_REAL((bits & 0x7fffff) | 0x3f800000);
+  FOG_INT big = m > (FOG_REAL)0x1.6a09e6p+0f;
+  m = big ? m * (FOG_REAL)0.5f : m;
+  k = big ? k + (FOG_REAL)1 : k;
+  FOG_REAL f = m - (FOG_REAL)1;
+  FOG_REAL t = f / ((FOG_REAL)2 + f), z = t * t;
+  FOG_REAL r = fma(z, (FOG_REAL)0x1.745d18p-3f, (FOG_REAL)0x1.c71c72p-3f);
+  r = fma(r, z, (FOG_REAL)0x1.24924ap-2f);
+  r = fma(r, z, (FOG_REAL)0x1.99999ap-2f);
+  r = fma(r, z, (FOG_REAL)0x1.555556p-1f);
+  FOG_REAL log_m = fma(t * z, r, t + t);
+  FOG_REAL log_u = fma(k, (FOG_REAL)0x1.62e4p-1f, fma(k, (FOG_REAL)0x1.7f7d1cp-20f, log_m));
+  return u == (FOG_REAL)1 ? y : log_u * (y / (u - (FOG_REAL)1));
+}
+#ifdef __OPENCL_C_VERSION__
+#ifndef FOG_EXP
+#define FOG_EXP FOG_NAME(fog_exp_poly)
+#define FOG_EXPM1 FOG_NAME(fog_expm1_neg_poly)
+#define FOG_LOG1P FOG_NAME(fog_log1p_neg_poly)
+#endif
+#endif
+
 /* G(a) = (1 - e^-a) / a for a >= 0, G(0) = 1 by a select: expm1 keeps every digit of tiny a, so
  * no series branch is needed (Unreal's switches to a Taylor series below |x| = 0.01). */
-FOG_FN FOG_REAL FOG_NAME(fog_height_g)(FOG_REAL a) {
-  return a == (FOG_REAL)0 ? (FOG_REAL)1 : -expm1(-a) / a;
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_g)(FOG_REAL a) {
+  return a == (FOG_REAL)0 ? (FOG_REAL)1 : -FOG_EXPM1(-a) / a;
 }
 
 /* H = integral over [s0, s1] of e^(-k (h(s) - b)) ds along a ray whose height above the base is
@@ -394,7 +470,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_height_g)(FOG_REAL a) {
  * the end where the integrand is largest: only that one is exponentiated, so nothing overflows
  * that the true value does not. falloff == 0 (k = 0): H = L. sky_infinite (a fogged sky without a
  * cut-off: s1 = +inf): H = e^(-k (h0 - b)) / (k wy) where k wy > 0, else +inf. */
-FOG_FN FOG_REAL FOG_NAME(fog_height_length)(FOG_REAL s0, FOG_REAL s1, FOG_REAL wy, FOG_REAL d0, FOG_REAL k,
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_length)(FOG_REAL s0, FOG_REAL s1, FOG_REAL wy, FOG_REAL d0, FOG_REAL k,
                                             int falloff, FOG_INT sky_infinite) {
   FOG_REAL L = s1 - s0;
   if (!falloff) return L;
@@ -403,32 +479,32 @@ FOG_FN FOG_REAL FOG_NAME(fog_height_length)(FOG_REAL s0, FOG_REAL s1, FOG_REAL w
   FOG_REAL e0 = fma(s0, wy, d0); /* h0 - b */
   FOG_REAL e1 = fma(s1, wy, d0); /* h1 - b */
   FOG_REAL top = x >= (FOG_REAL)0 ? e0 : e1;
-  FOG_REAL h = L * exp(-k * top) * FOG_NAME(fog_height_g)(fabs(x));
-  FOG_REAL h_inf = kwy > (FOG_REAL)0 ? exp(-k * e0) / kwy : (FOG_REAL)INFINITY;
+  FOG_REAL h = L * FOG_EXP(-k * top) * FOG_NAME(fog_height_g)(fabs(x));
+  FOG_REAL h_inf = kwy > (FOG_REAL)0 ? FOG_EXP(-k * e0) / kwy : (FOG_REAL)INFINITY;
   return sky_infinite ? h_inf : h;
 }
 
 /* The optical depth beta * H with 0 * inf = 0: a zero coefficient is no fog in its channel. */
-FOG_FN FOG_REAL FOG_NAME(fog_height_depth)(FOG_REAL beta, FOG_REAL h) {
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_depth)(FOG_REAL beta, FOG_REAL h) {
   return beta == (FOG_REAL)0 ? (FOG_REAL)0 : beta * h;
 }
 
 /* The sun lobe max(cos θ, 0)^e from q = 1 - cos θ = |ω - ℓ|^2 / 2 (ω, ℓ unit vectors): the
  * difference keeps the digits of small angles that a rounded cosine loses (e = 1000 near the
  * peak), and exp(e log1p(-q)) those of the power. 0 where cos θ <= 0 (q >= 1). */
-FOG_FN FOG_REAL FOG_NAME(fog_sun_lobe)(FOG_REAL q, FOG_REAL e) {
-  return q < (FOG_REAL)1 ? exp(e * log1p(-q)) : (FOG_REAL)0;
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_sun_lobe)(FOG_REAL q, FOG_REAL e) {
+  return q < (FOG_REAL)1 ? FOG_EXP(e * FOG_LOG1P(-q)) : (FOG_REAL)0;
 }
 
 /* 1 - cos(ω, ℓ) = |ω - ℓ|^2 / 2 for unit ω = (wx, wy, wz) and ℓ. */
-FOG_FN FOG_REAL FOG_NAME(fog_sun_q)(FOG_REAL wx, FOG_REAL wy, FOG_REAL wz, FOG_REAL lx, FOG_REAL ly, FOG_REAL lz) {
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_sun_q)(FOG_REAL wx, FOG_REAL wy, FOG_REAL wz, FOG_REAL lx, FOG_REAL ly, FOG_REAL lz) {
   FOG_REAL dx = wx - lx, dy = wy - ly, dz = wz - lz;
   return fma(dx, dx, fma(dy, dy, dz * dz)) * (FOG_REAL)0.5f;
 }
 
 /* One channel's output color * T + F * J + sun (sun = S λ J_sun). T == 0 contributes exactly 0,
  * whatever the color (a hidden NaN or Inf never leaks). */
-FOG_FN FOG_REAL FOG_NAME(fog_height_blend)(FOG_REAL c, FOG_REAL t, FOG_REAL f, FOG_REAL j, FOG_REAL sun) {
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_blend)(FOG_REAL c, FOG_REAL t, FOG_REAL f, FOG_REAL j, FOG_REAL sun) {
   FOG_REAL added = fma(f, j, sun);
   return t == (FOG_REAL)0 ? added : fma(c, t, added);
 }
@@ -438,7 +514,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_height_blend)(FOG_REAL c, FOG_REAL t, FOG_REAL f, F
  * d0: the ray origin's height - b, q_sun: 1 - cos(ω, ℓ) (read with FOG_HF_SUN), p: FOG_HP_*
  * constants, features: FOG_HF_* bits. Returns 0, leaving rgb untouched, where the pixel passes
  * through bit for bit (sky without FOG_HF_SKYBOX, an empty segment, H = 0 and H_sun = 0). */
-FOG_FN int FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky, FOG_REAL wy, FOG_REAL d0,
+FOG_FN_INLINE int FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky, FOG_REAL wy, FOG_REAL d0,
                                       FOG_REAL q_sun, const FOG_REAL* p, int features) {
   const int rgb_channels = (features & FOG_HF_RGB) ? 3 : 1;
   const int falloff = (features & FOG_HF_FALLOFF) != 0;
@@ -467,9 +543,9 @@ FOG_FN int FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky
   if (h == (FOG_REAL)0 && h_sun == (FOG_REAL)0) return 0;
   FOG_REAL t[3], j[3], j_sun[3];
   for (int c = 0; c < rgb_channels; ++c) {
-    t[c] = exp(-FOG_NAME(fog_height_depth)(p[FOG_HP_EXT + c], h));
-    j[c] = -expm1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h));
-    j_sun[c] = (features & FOG_HF_SUN_START) ? -expm1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h_sun)) : j[c];
+    t[c] = FOG_EXP(-FOG_NAME(fog_height_depth)(p[FOG_HP_EXT + c], h));
+    j[c] = -FOG_EXPM1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h));
+    j_sun[c] = (features & FOG_HF_SUN_START) ? -FOG_EXPM1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h_sun)) : j[c];
     if (features & FOG_HF_MAX_OPACITY) {
       t[c] = fmax(t[c], p[FOG_HP_MIN_T]);
       j[c] = fmin(j[c], p[FOG_HP_MAX]);
@@ -490,7 +566,7 @@ FOG_FN int FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky
  * with `sun`), d0: eye.y - b. Returns s_hit, the distance along the ray from the eye (§2's
  * distance-based metric; orthographic: eye depth from the view plane) and writes the sky flag,
  * ω.y, the ray origin's height - b and 1 - cos(ω, ℓ). */
-FOG_FN FOG_REAL FOG_NAME(fog_height_geometry)(FOG_REAL raw, FOG_REAL cx, FOG_REAL cy, FOG_REAL cz, int kind,
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_geometry)(FOG_REAL raw, FOG_REAL cx, FOG_REAL cy, FOG_REAL cz, int kind,
                                               int reversed_z, int projection, FOG_REAL zx, FOG_REAL zy,
                                               FOG_REAL near_plane, FOG_REAL far_plane, FOG_REAL ux, FOG_REAL uy,
                                               FOG_REAL uz, FOG_REAL lx, FOG_REAL ly, FOG_REAL lz, int sun,
@@ -523,6 +599,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_height_geometry)(FOG_REAL raw, FOG_REAL cx, FOG_REA
 #undef FOG_TRUNC_INT
 #undef FOG_TO_REAL
 #undef FOG_AS_REAL
+#undef FOG_AS_INT
 #undef FOG_CEIL
 #undef FOG_EXP2_LDEXP
 #undef FOG_NAME

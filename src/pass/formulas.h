@@ -15,6 +15,7 @@ namespace fogcl::formulas {
 using std::exp;
 using std::expm1;
 using std::fabs;
+using std::floor;
 using std::fma;
 using std::log1p;
 using std::fmax;
@@ -34,6 +35,19 @@ inline float fog_as_real(std::int32_t i) {
 // that call it: lookup of a dependent call on a fundamental type happens at their definition.
 inline float fog_exp2(float x);
 inline double fog_exp2(double x) { return std::exp2(std::fmin(x, 0.0)); }
+inline std::int32_t fog_as_int(float x) {
+  std::int32_t i;
+  std::memcpy(&i, &x, sizeof i);
+  return i;
+}
+// Height fog's exp, expm1 and log1p: the float paths the kernel's polynomials (fog_exp_poly, ...),
+// the double reference the C library's.
+inline float fog_exp(float x);
+inline float fog_expm1(float x);
+inline float fog_log1p(float x);
+inline double fog_exp(double x) { return std::exp(x); }
+inline double fog_expm1(double x) { return std::expm1(x); }
+inline double fog_log1p(double x) { return std::log1p(x); }
 
 #define FOG_INT int
 #define FOG_NAME(name) name
@@ -41,12 +55,22 @@ inline double fog_exp2(double x) { return std::exp2(std::fmin(x, 0.0)); }
 #define FOG_TO_REAL fog_to_real
 #define FOG_AS_REAL fog_as_real
 #define FOG_EXP2 fog_exp2
+#define FOG_EXP fog_exp
+#define FOG_EXPM1 fog_expm1
+#define FOG_LOG1P fog_log1p
+#define FOG_AS_INT fog_as_int
 #define FOG_CLAMP_BY_SELECT
 #include "fog_math.h"  // undefines the instance macros
 #undef FOG_EXP2
+#undef FOG_EXP
+#undef FOG_EXPM1
+#undef FOG_LOG1P
 #undef FOG_CLAMP_BY_SELECT
 
 inline float fog_exp2(float x) { return fog_exp2_poly(x); }
+inline float fog_exp(float x) { return fog_exp_poly(x); }
+inline float fog_expm1(float x) { return fog_expm1_neg_poly(x); }
+inline float fog_log1p(float x) { return fog_log1p_neg_poly(x); }
 
 // The ray term of a pixel (fog_ray_term: |ray(u, v)|, or its square where `squared`): each
 // component interpolated from the frustum corners (fog_bilerp). The kernel composes the same
