@@ -52,6 +52,7 @@
 #include "fogcl/volume_pass.h"
 #include "fogcl/volume_scalar.h"
 #include "runtime/clhpp.h"
+#include "runtime/work_groups.h"
 #include "volume/volume_formulas.h"
 #include "volume/volume_params.h"
 #include "volume_composite_cl.h"
@@ -327,15 +328,18 @@ void BM_VolumeCompositeKernel(benchmark::State& state) {
   int arg = 0;
   for (const cl::Buffer* b : {&in, &d, &out, &k, &low, &key}) kernel.setArg(arg++, *b);
   const cl::CommandQueue queue(ctx, device, CL_QUEUE_PROFILING_ENABLE);
+  // Launched as the pass launches it: its work-group shape, the global size rounded up to it.
+  const detail::WorkGroupShape shape = detail::work_group_shape(
+      kernel, device, detail::volume_composite_private_bytes(packed.variant, traits));
   const auto size = detail::volume_composite_global(packed.variant, traits, f.color.width(), f.color.height());
-  const cl::NDRange global(size[0], size[1]);
+  const cl::NDRange global = shape.global(size[0], size[1]);
   // A copy of the frame's bytes after each dispatch, so that the two medians share the machine's
   // minutes (a copy measured after the loop moved by +-40 % against the composite's minutes).
   FrameCopy copy(input, f.depth);
   std::vector<double> composite_ms, copy_ms;
   for (auto _ : state) {
     cl::Event done;
-    queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, cl::NullRange, nullptr, &done);
+    queue.enqueueNDRangeKernel(kernel, cl::NullRange, global, shape.local(), nullptr, &done);
     done.wait();
     const double ms = event_ms(done, CL_PROFILING_COMMAND_START, done, CL_PROFILING_COMMAND_END);
     composite_ms.push_back(ms);

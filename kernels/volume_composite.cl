@@ -14,7 +14,8 @@
  *                    written with non-temporal stores (0: every frame; absent: none)
  * Global size: volume_composite_global() (src/volume/volume_params.h): (ceil(width / VOL_LANES), height),
  * or on CPU devices with VOL_SCALE > 1 (ceil(width / 16), the target row pairs: one work-item
- * takes the VOL_SCALE frame rows between two target rows, volume_composite_cpu.h).
+ * takes the VOL_SCALE frame rows between two target rows, volume_composite_cpu.h), rounded up to
+ * whole work-groups (src/runtime/work_groups.h): work-items past the frame return.
  */
 #pragma OPENCL FP_CONTRACT OFF
 
@@ -101,16 +102,17 @@ kernel void volume_composite(global const COLOR_T* color_in, global const float*
   const size_t row = (size_t)y * (size_t)width;
   if (x0 + 16 <= width) {
     vol_composite16(color_in, color_out, low, row + x0, stream);
-  } else {
+  } else { /* the row's tail; none for work-items past the row (x0 >= width) */
     for (int x = x0; x < width; ++x) vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, row + x, x, y);
   }
 #else
   const int m = get_global_id(1); /* the target row pair: frame rows vol_rows_of(m) */
+  int first, last;
+  vol_rows_of(m, height, &first, &last);
+  if (first >= last) return; /* past the last pair: the global size is rounded up to whole work-groups */
   if (x0 + 16 <= width) {
     vol_composite16(color_in, depth, color_out, frame, low, low_key, x0, m, width, height, stream);
-  } else {
-    int first, last;
-    vol_rows_of(m, height, &first, &last);
+  } else { /* the row's tail; none for work-items past the row (x0 >= width) */
     for (int y = first; y < last; ++y)
       for (int x = x0; x < width; ++x)
         vol_composite_pixel(color_in, depth, color_out, frame, low, low_key, (size_t)y * (size_t)width + x, x, y);

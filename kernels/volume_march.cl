@@ -21,7 +21,8 @@
  * second time on float16 (volume_common.h), every lane runs all `steps` iterations of each volume
  * some lane enters, and lanes that do not enter it are masked. Setting up the rays and shading a
  * marched volume stay per pixel (the scalar functions, in a loop over the lanes). GPUs keep one
- * pixel per work-item. Global size: (ceil(ceil(W / s) / VOL_LANES), ceil(H / s)).
+ * pixel per work-item. Global size: (ceil(ceil(W / s) / VOL_LANES), ceil(H / s)), rounded up to
+ * whole work-groups (src/runtime/work_groups.h): work-items past the target return.
  */
 #pragma OPENCL FP_CONTRACT OFF
 

@@ -362,6 +362,26 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
   return o;
 }
 
+// The private arrays per target pixel (a lane) of kernels/volume_march.cl, in 4-byte words: the
+// ray, its occluder, key, jitter and result (13); the staging of the noise and shadow-map helpers
+// inlined into it (10); the stylized march's per-volume entries (7), or the physical walk's state
+// (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES). Twice that for what the
+// compiler keeps besides (spilled vectors, copies): PoCL 3.1's work-group functions hold 0.9-1.15x
+// the arrays per work-item (their stack frames: 6.4-6.8 KB physical, 1.7-2.2 KB stylized at 16
+// lanes).
+std::size_t volume_march_private_bytes(const VolumeVariant& v, const DeviceTraits& device) {
+  const std::size_t per_lane =
+      13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES);
+  return 2 * 4 * per_lane * std::size_t(volume_march_lanes(v, device));
+}
+
+// kernels/volume_composite.h, volume_composite_cpu.h: the upsampling's distances, weights and
+// taps (4 + 4 floats, 4 float4) and the half stores' staging (16 halves), twice over as above
+// (97-145 bytes per work-item measured).
+std::size_t volume_composite_private_bytes(const VolumeVariant&, const DeviceTraits&) {
+  return 2 * (4 * (4 + 4 + 16) + 2 * 16);
+}
+
 std::string volume_composite_options(const VolumeVariant& v, const DeviceTraits& device) {
   std::string o = cl_std_option(device);
   o += " -D VOL_SCALE=" + std::to_string(v.scale);

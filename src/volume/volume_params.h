@@ -59,6 +59,11 @@ int integrator_code(VolumeIntegrator integrator);
 int volume_march_lanes(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_march_options(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_composite_options(const VolumeVariant& variant, const DeviceTraits& device);
+// Upper bounds of one work-item's private memory [bytes] in the march and the composite of a
+// variant, from the kernels' private arrays: what the launches' work-group shape is bounded by
+// where the device reports less (runtime/work_groups.h).
+std::size_t volume_march_private_bytes(const VolumeVariant& variant, const DeviceTraits& device);
+std::size_t volume_composite_private_bytes(const VolumeVariant& variant, const DeviceTraits& device);
 // The composite's global size for a width x height frame (kernels/volume_composite.cl): one
 // work-item per frame pixel, or on CPU devices per 16 pixels of a row; there, at scale > 1, of the
 // `scale` rows between two target rows (which share the target's windows).

@@ -7,6 +7,7 @@
 #include "fogcl/error.h"
 #include "runtime/clhpp.h"
 #include "runtime/frame_buffers.h"
+#include "runtime/work_groups.h"
 #include "volume/volume_params.h"
 #include "volume_composite_cl.h"
 #include "volume_march_cl.h"
@@ -35,36 +36,45 @@ struct VolumePass::Impl {
   cl::CommandQueue queue;  // convenience queue
   DeviceTraits traits;
   bool images = false;     // the device supports images
-  std::map<std::string, cl::Kernel> kernels;  // by source name + options
+  struct KernelEntry {
+    cl::Kernel kernel;
+    detail::WorkGroupShape shape;  // its launches' local size (runtime/work_groups.h)
+  };
+  std::map<std::string, KernelEntry> kernels;  // by source name + options
   // (size, seed, as image) -> the texture on the device and its upload's event
   std::map<std::tuple<int, unsigned, int>, std::pair<cl::Memory, cl::Event>> noise;
   VolumePassStats stats;
   std::string last_march_options, last_composite_options;
 
   // The kernel of a built program, or nullptr (never builds; creates the kernel object when
-  // another pass sharing the cache built the program).
-  cl::Kernel* find_kernel(const Source& source, const std::string& options) {
+  // another pass sharing the cache built the program). private_bytes: the host's bound of a work-item's
+  // private memory (volume_params.h), for its work-group shape.
+  KernelEntry* find_kernel(const Source& source, const std::string& options, std::size_t private_bytes) {
     const std::string key = std::string(source.name) + '\n' + options;
     auto it = kernels.find(key);
     if (it == kernels.end()) {
       const cl_program program = programs->find(device(), source.name, options);
       if (program == nullptr) return nullptr;
-      it = kernels.emplace(key, with_cl_errors([&] { return cl::Kernel(wrap(program), source.kernel); })).first;
+      it = kernels.emplace(key, with_cl_errors([&] {
+        KernelEntry e{cl::Kernel(wrap(program), source.kernel), {}};
+        e.shape = detail::work_group_shape(e.kernel, device, private_bytes);
+        return e;
+      })).first;
     }
     return &it->second;
   }
-  cl::Kernel& prepared_kernel(const Source& source, const std::string& options) {
-    cl::Kernel* k = find_kernel(source, options);
+  KernelEntry& prepared_kernel(const Source& source, const std::string& options, std::size_t private_bytes) {
+    KernelEntry* k = find_kernel(source, options, private_bytes);
     if (k == nullptr)
       throw Error(std::string("volumetric variant '") + options + "' of " + source.name +
                   " is not prepared: call VolumePass::prepare(camera, scene, settings, storage, shadow) "
                   "before enqueue, which never builds a program");
     return *k;
   }
-  void build(const Source& source, const std::string& options) {
-    if (find_kernel(source, options) != nullptr) return;
+  void build(const Source& source, const std::string& options, std::size_t private_bytes) {
+    if (find_kernel(source, options, private_bytes) != nullptr) return;
     programs->get(device(), source.name, source.text, options);
-    find_kernel(source, options);
+    find_kernel(source, options, private_bytes);
   }
   const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
                                     std::vector<cl::Event>& waits);
@@ -145,8 +155,10 @@ void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, c
   const detail::PackedVolumeFrame f =
       detail::pack_volume_frame(1, 1, camera, scene, settings, storage, shadow, 1, 1, INFINITY);
   if (f.visible.empty()) return;
-  m.build(kMarch, detail::volume_march_options(f.variant, m.traits));
-  m.build(kComposite, detail::volume_composite_options(f.variant, m.traits));
+  m.build(kMarch, detail::volume_march_options(f.variant, m.traits),
+          detail::volume_march_private_bytes(f.variant, m.traits));
+  m.build(kComposite, detail::volume_composite_options(f.variant, m.traits),
+          detail::volume_composite_private_bytes(f.variant, m.traits));
 }
 
 cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
@@ -187,8 +199,12 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     }
     const std::string march_options = detail::volume_march_options(f.variant, m.traits);
     const std::string composite_options = detail::volume_composite_options(f.variant, m.traits);
-    cl::Kernel& march = m.prepared_kernel(kMarch, march_options);
-    cl::Kernel& composite = m.prepared_kernel(kComposite, composite_options);
+    Impl::KernelEntry& march_entry =
+        m.prepared_kernel(kMarch, march_options, detail::volume_march_private_bytes(f.variant, m.traits));
+    Impl::KernelEntry& composite_entry =
+        m.prepared_kernel(kComposite, composite_options, detail::volume_composite_private_bytes(f.variant, m.traits));
+    cl::Kernel& march = march_entry.kernel;
+    cl::Kernel& composite = composite_entry.kernel;
     m.last_march_options = march_options;
     m.last_composite_options = composite_options;
     const cl::Buffer frame = constant_buffer(m.context, f.frame.data(), f.frame.size());
@@ -217,9 +233,9 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     cl::Event marched;
     const int march_lanes = detail::volume_march_lanes(f.variant, m.traits);  // target pixels per work-item
     queue.enqueueNDRangeKernel(march, cl::NullRange,
-                               cl::NDRange((f.low_width + march_lanes - 1) / march_lanes, f.low_height),
-                               cl::NullRange,
-                               waits.empty() ? nullptr : &waits, &marched);
+                               march_entry.shape.global(std::size_t((f.low_width + march_lanes - 1) / march_lanes),
+                                                        std::size_t(f.low_height)),
+                               march_entry.shape.local(), waits.empty() ? nullptr : &waits, &marched);
     ++m.stats.march_dispatches;
     composite.setArg(0, wrap(fb.color_in));
     composite.setArg(1, depth);
@@ -229,8 +245,8 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
     composite.setArg(5, low_key);
     const std::vector<cl::Event> after{marched};
     const auto global = detail::volume_composite_global(f.variant, m.traits, fb.width, fb.height);
-    queue.enqueueNDRangeKernel(composite, cl::NullRange, cl::NDRange(global[0], global[1]), cl::NullRange, &after,
-                               &done);
+    queue.enqueueNDRangeKernel(composite, cl::NullRange, composite_entry.shape.global(global[0], global[1]),
+                               composite_entry.shape.local(), &after, &done);
     ++m.stats.composite_dispatches;
     return share(done);
   });
