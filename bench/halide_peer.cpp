@@ -43,6 +43,90 @@ Expr fog_exp2(const Expr& x) {
   return select(x < -126.0f, f32(0), p * scale);
 }
 
+// The peer's schedule. The defaults are the fastest found on the 2-vCPU Xeon (see the figures at
+// the end of this file); FOGCL_HALIDE_SCHEDULE overrides them for the exploration, a comma list of
+//   vec=N        pixels a vector (8, 16, 32)
+//   rows=N       rows a parallel task (1: parallel(y), each row a task)
+//   factor=at|inline  the factors computed per vector (compute_at) or inline in the blend
+//   target=host|avx512|skylake|avx2  host: the JIT host target less AVX512_SapphireRapids;
+//                avx512: only the AVX512 base feature; skylake: AVX512 + AVX512_Skylake; avx2: no AVX-512
+//   asserts=0    NoAsserts and NoBoundsQuery added to the target
+struct Schedule {
+  int vector = 16;
+  int rows = 1;
+  bool factor_at_vector = true;
+  Halide::Target target;
+};
+
+Halide::Target host_target() {
+  // Halide 14 takes AVX512-BF16 + VNNI for Sapphire Rapids and then emits AVX512-FP16 for half
+  // conversions: on a Zen 4 EPYC (BF16, no FP16) that is SIGILL. F16C does the conversions.
+  return Halide::get_jit_target_from_environment().without_feature(Halide::Target::AVX512_SapphireRapids);
+}
+
+Schedule parse_schedule(const char* text) {
+  using T = Halide::Target;
+  Schedule s;
+  s.target = host_target();
+  std::string list = text != nullptr ? text : "";
+  std::size_t at = 0;
+  while (at < list.size()) {
+    std::size_t end = list.find(',', at);
+    if (end == std::string::npos) end = list.size();
+    const std::string item = list.substr(at, end - at);
+    at = end + 1;
+    const std::size_t eq = item.find('=');
+    const std::string key = item.substr(0, eq), value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    if (key == "vec") s.vector = std::stoi(value);
+    else if (key == "rows") s.rows = std::stoi(value);
+    else if (key == "factor") s.factor_at_vector = value != "inline";
+    else if (key == "target") {
+      const T base = s.target.without_feature(T::AVX512).without_feature(T::AVX512_Skylake)
+                         .without_feature(T::AVX512_Cannonlake).without_feature(T::AVX512_SapphireRapids);
+      if (value == "avx2") s.target = base;
+      else if (value == "avx512") s.target = base.with_feature(T::AVX512);
+      else if (value == "skylake") s.target = base.with_feature(T::AVX512).with_feature(T::AVX512_Skylake);
+    } else if (key == "asserts" && value == "0") {
+      s.target = s.target.with_feature(T::NoAsserts).with_feature(T::NoBoundsQuery);
+    }
+  }
+  return s;
+}
+
+const Schedule& schedule() {
+  static const Schedule s = parse_schedule(std::getenv("FOGCL_HALIDE_SCHEDULE"));
+  return s;
+}
+
+// Halide's JIT runtime reads HL_NUM_THREADS when its thread pool starts (the first parallel
+// realize); an explicit setting in the environment wins.
+void size_pool(int threads) {
+  static const bool sized = [&] {
+    setenv("HL_NUM_THREADS", std::to_string(threads).c_str(), 0);
+    return true;
+  }();
+  (void)sized;
+}
+
+// A copy of 32-bit words, rows x row_words, in the peer's target and parallel over rows (or on
+// the calling thread alone): the Halide entry of the bench's copy ceiling.
+struct CopyPipeline {
+  Halide::ImageParam in{Halide::UInt(32), 2, "copy_in"};
+  Halide::Func out{"copied"};
+  Halide::Pipeline pipeline;
+  Halide::Target target;
+
+  explicit CopyPipeline(bool parallel) {
+    Halide::Var x("x"), y("y"), xo("xo"), xi("xi");
+    out(x, y) = in(x, y);
+    out.split(x, xo, xi, 64).vectorize(xi, 16).unroll(xi);  // four 512-bit vectors a step
+    if (parallel) out.parallel(y);
+    target = schedule().target;
+    pipeline = Halide::Pipeline(out);
+    pipeline.compile_jit(target);
+  }
+};
+
 // One JIT-compiled pipeline: a variant and a storage format, any frame size.
 struct Pipeline {
   Halide::ImageParam color, depth;
@@ -140,14 +224,19 @@ Pipeline::Pipeline(const Variant& v, ColorFormat storage)
   color.dim(1).set_stride(4);
   out.output_buffer().dim(0).set_bounds(0, 4).set_stride(1);
   out.output_buffer().dim(1).set_stride(4);
-  // Rows in parallel, 16 pixels a vector, the four channels unrolled (Halide turns the four
-  // stride-4 stores into one interleaved store); the factors of 16 pixels computed per vector.
-  out.reorder(c, x, y).bound(c, 0, 4).unroll(c).split(x, xo, xi, 16).vectorize(xi).parallel(y);
-  factor.compute_at(out, xo).vectorize(x, 16);
-
-  // Halide 14 takes AVX512-BF16 + VNNI for Sapphire Rapids and then emits AVX512-FP16 for half
-  // conversions: on a Zen 4 EPYC (BF16, no FP16) that is SIGILL. F16C does the conversions.
-  target = Halide::get_jit_target_from_environment().without_feature(Halide::Target::AVX512_SapphireRapids);
+  // Vectors of s.vector pixels over x, the four channels unrolled (Halide turns the four
+  // stride-4 stores into one interleaved store), rows (or bands of s.rows rows) in parallel; the
+  // factors of a vector computed once per vector (or inline, CSE'd across the unrolled channels).
+  const Schedule& s = schedule();
+  out.reorder(c, x, y).bound(c, 0, 4).unroll(c).split(x, xo, xi, s.vector).vectorize(xi);
+  if (s.rows > 1) {
+    Var yo("yo"), yi("yi");
+    out.split(y, yo, yi, s.rows).parallel(yo);
+  } else {
+    out.parallel(y);
+  }
+  if (s.factor_at_vector) factor.compute_at(out, xo).vectorize(x, s.vector);
+  target = s.target;
   pipeline = Halide::Pipeline(out);
   pipeline.compile_jit(target);
 }
@@ -156,13 +245,7 @@ using Key = std::tuple<int, bool, bool, bool, int, int>;
 
 Pipeline& pipeline_for(const Variant& v, ColorFormat storage, int threads) {
   static std::map<Key, std::unique_ptr<Pipeline>> pipelines;
-  static const bool pool_sized = [&] {
-    // Halide's JIT runtime reads HL_NUM_THREADS when its thread pool starts (the first parallel
-    // realize); an explicit setting in the environment wins.
-    setenv("HL_NUM_THREADS", std::to_string(threads).c_str(), 0);
-    return true;
-  }();
-  (void)pool_sized;
+  size_pool(threads);
   const Key key{int(v.mode), v.distance, v.fog_skybox, v.reversed_z, int(v.projection), int(storage)};
   auto& p = pipelines[key];
   if (!p) p = std::make_unique<Pipeline>(v, storage);
@@ -215,4 +298,17 @@ extern "C" void fogcl_halide_fog(const ColorImage& in, const DepthImage& depth, 
   p.color.set(color_in);
   p.depth.set(depth_in);
   p.pipeline.realize(color_out, p.target);
+}
+
+extern "C" void fogcl_halide_copy(const void* src, void* dst, std::size_t row_bytes, int rows, int threads) {
+  using fogcl::bench::CopyPipeline;
+  fogcl::bench::size_pool(threads);
+  static CopyPipeline serial(false), parallel(true);
+  CopyPipeline& p = threads > 1 ? parallel : serial;
+  const int words = int(row_bytes / 4);
+  halide_dimension_t shape[2] = {{0, words, 1}, {0, rows, words}};
+  Halide::Buffer<> in(Halide::UInt(32), const_cast<void*>(src), 2, shape);
+  Halide::Buffer<> out(Halide::UInt(32), dst, 2, shape);
+  p.in.set(in);
+  p.pipeline.realize(out, p.target);
 }

@@ -6,6 +6,8 @@
 // when CMake finds Halide (bench/CMakeLists.txt; `scripts/setup.sh --bench` installs it).
 #pragma once
 
+#include <cstddef>
+
 #include "fogcl/camera.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
@@ -22,6 +24,10 @@ using HalidePrepare = void(const CameraParams& camera, const FogSettings& settin
 using HalideFog = void(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
                        const FogSettings& settings, int threads);
 
+// Copies rows x row_bytes (a multiple of 4) from src to dst with a Halide pipeline (32-bit words,
+// 64 a step, rows in parallel when threads > 1): the Halide entry of the bench's copy ceiling.
+using HalideCopy = void(const void* src, void* dst, std::size_t row_bytes, int rows, int threads);
+
 }  // namespace fogcl::bench
 
 // The module's entry points (bench/CMakeLists.txt builds it as a module that fog_bench.cpp loads
@@ -29,3 +35,4 @@ using HalideFog = void(const ColorImage& in, const DepthImage& depth, ColorImage
 // LLVM 15).
 extern "C" fogcl::bench::HalidePrepare fogcl_halide_prepare;
 extern "C" fogcl::bench::HalideFog fogcl_halide_fog;
+extern "C" fogcl::bench::HalideCopy fogcl_halide_copy;
