@@ -866,9 +866,10 @@ void DeviceArgs(benchmark::internal::Benchmark* b) {
 // runs. PoCL runs a grid this small on one thread.
 void CacheResidentArgs(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h", "mode", "dist", "f16", "nt"});
-  for (int mode : {0, 1, 2})
+  for (int mode : {0, 1, 2, 3, 4})
     for (int dist : {0, 1})
-      for (int f16 : {0, 1}) b->Args({512, 256, mode, dist, f16, 2});
+      for (int f16 : {0, 1})
+        if (mode < 3 || dist == 0) b->Args({512, 256, mode, dist, f16, 2});
   b->UseManualTime()->Unit(benchmark::kMicrosecond)->MinTime(0.2);
 }
 

@@ -241,6 +241,58 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
 #include "fog_cpu_blocks.h"
 #endif
 
+#if FOG_VECTOR_WIDTH == 16 && FOG_MODE == FOG_MODE_HEIGHT
+/* Height fog on 16 pixels of a row (CPU devices): the same formulas on float16 lanes, one pixel a
+ * lane; the colors are split into R, G, B vectors and put back together by shuffles. Pixels that
+ * pass through keep their bits (a select in float storage; copied back in half storage). */
+#define FOG_H_QUAD(q, a, b, c, d)                                                                     \
+  (float16)(rgb[0].s##a, rgb[1].s##a, rgb[2].s##a, q.s3, rgb[0].s##b, rgb[1].s##b, rgb[2].s##b, q.s7, \
+            rgb[0].s##c, rgb[1].s##c, rgb[2].s##c, q.sb, rgb[0].s##d, rgb[1].s##d, rgb[2].s##d, q.sf)
+static inline void fog_height_pixels16(global const COLOR_T* color_in, global const float* depth,
+                                       global COLOR_T* color_out, size_t i0, int x0, int y,
+                                       const FogConstants* k) {
+  const float16 lane = (float16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const float16 u = fog_pixel_u_v((float16)((float)x0) + lane, (float16)k->inv_width);
+  const float16 v = (float16)fog_pixel_v((float)y, k->height);
+  int16 sky;
+  float16 wy, d0, q_sun;
+  const float16 s_hit = fog_height_geometry_v(
+      vload16(0, depth + i0), fog_bilerp_v((float16)k->bl.x, (float16)k->br.x, (float16)k->tl.x, (float16)k->tr.x, u, v),
+      fog_bilerp_v((float16)k->bl.y, (float16)k->br.y, (float16)k->tl.y, (float16)k->tr.y, u, v),
+      fog_bilerp_v((float16)k->bl.z, (float16)k->br.z, (float16)k->tl.z, (float16)k->tr.z, u, v), FOG_DEPTH_KIND,
+      FOG_USE_REVERSED_Z, FOG_PROJECTION, (float16)k->zx, (float16)k->zy, (float16)k->near_plane,
+      (float16)k->far_plane, (float16)k->up.x, (float16)k->up.y, (float16)k->up.z, (float16)k->light.x,
+      (float16)k->light.y, (float16)k->light.z, FOG_HB_SUN != 0, (float16)k->d0, &sky, &wy, &d0, &q_sun);
+  global const COLOR_T* in = color_in + 4 * i0;
+  global COLOR_T* out = color_out + 4 * i0;
+  const float16 q0 = fog_load_quad(in, 0), q1 = fog_load_quad(in, 1), q2 = fog_load_quad(in, 2),
+                q3 = fog_load_quad(in, 3);
+  float16 rgb[3] = {(float16)(q0.s048c, q1.s048c, q2.s048c, q3.s048c),
+                    (float16)(q0.s159d, q1.s159d, q2.s159d, q3.s159d),
+                    (float16)(q0.s26ae, q1.s26ae, q2.s26ae, q3.s26ae)};
+  const int16 fogged = fog_height_pixel_v(rgb, s_hit, sky, wy, d0, q_sun, k->hp, FOG_HEIGHT_BITS);
+  /* Lanes passed through: bit j set where pixel j is not fogged. */
+  const uint keep = fog_lanes_equal(as_float16(fogged & as_int16((float16)1.0f)), 0.0f);
+  global const uint* in_bits = (global const uint*)in;
+  global uint* out_bits = (global uint*)out;
+  if (keep == 0xffffu) {
+    for (uint w = 0; w < 16 * sizeof(COLOR_T); ++w) out_bits[w] = in_bits[w];
+    return;
+  }
+  fog_store_quad(FOG_H_QUAD(q0, 0, 1, 2, 3), out, 0, k);
+  fog_store_quad(FOG_H_QUAD(q1, 4, 5, 6, 7), out, 1, k);
+  fog_store_quad(FOG_H_QUAD(q2, 8, 9, a, b), out, 2, k);
+  fog_store_quad(FOG_H_QUAD(q3, c, d, e, f), out, 3, k);
+#ifdef FOG_COLOR_HALF
+  if (keep != 0)
+    for (uint j = 0; j < 16; ++j)
+      if (keep & (1u << j)) vstore2(vload2(j, in_bits), j, out_bits);
+#endif
+}
+#undef FOG_H_QUAD
+#define fog_pixels16 fog_height_pixels16
+#endif
+
 kernel void deferred_fog(global const COLOR_T* color_in, global const float* depth,
                          global COLOR_T* color_out, int width, int height,
                          float4 zbuffer_params, float4 projection_params, float4 corner_bl,

@@ -359,9 +359,8 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
 /* ---- Height and atmospheric fog (docs/DESIGN.md §6: Unreal's exponential height fog, Filament's
  * and Godot's height falloff, Bevy's per-channel extinction and in-scattering, a sun lobe) ----
  * In closed form, without a branch on the value and without an epsilon. Written for the
- * one-pixel instances (OpenCL C float, C++ float and double); the 16-pixel instance skips it. */
-#ifndef FOG_LANES16
-
+ * one-pixel instances (OpenCL C float, C++ float and double) and the 16-pixel one alike: every choice
+ * on a pixel's value is a select. */
 /* What a height-fog variant uses (FOG_HEIGHT_* build options; HeightCoefficients on the host):
  * a bit mask that is a compile-time constant in the kernel, so unused parts fold away. */
 #ifndef FOG_HF_FALLOFF
@@ -386,6 +385,12 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
 #define FOG_HP_FOG 13        /* fog color F */
 #define FOG_HP_SUN 16        /* sun color S */
 #define FOG_HP_COUNT 19
+/* The FOG_HP_* block's element type: float in OpenCL C (both instances), the path's real in C++. */
+#ifdef __OPENCL_C_VERSION__
+#define FOG_HP_T float
+#else
+#define FOG_HP_T FOG_REAL
+#endif
 #endif
 
 /* exp, expm1 and log1p of height fog, as branch-free polynomials for every float path (inlined, so
@@ -512,52 +517,56 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_blend)(FOG_REAL c, FOG_REAL t, FOG_RE
 /* The height fog of one pixel (docs/DESIGN.md §6.2) into rgb[0..2]. s_hit: distance along the ray
  * to the surface (fog_view_distance's distance-based metric), sky: the pixel is sky, wy: ω.y,
  * d0: the ray origin's height - b, q_sun: 1 - cos(ω, ℓ) (read with FOG_HF_SUN), p: FOG_HP_*
- * constants, features: FOG_HF_* bits. Returns 0, leaving rgb untouched, where the pixel passes
- * through bit for bit (sky without FOG_HF_SKYBOX, an empty segment, H = 0 and H_sun = 0). */
-FOG_FN_INLINE int FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky, FOG_REAL wy, FOG_REAL d0,
-                                      FOG_REAL q_sun, const FOG_REAL* p, int features) {
+ * constants, features: FOG_HF_* bits. Returns whether the pixel is fogged; where it is not, rgb
+ * is left untouched, bit for bit (sky without FOG_HF_SKYBOX, an empty segment, H = 0 and
+ * H_sun = 0). Branch-free on the pixel's values (selects), so that it runs on 16 lanes too. */
+FOG_FN_INLINE FOG_INT FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky, FOG_REAL wy,
+                                                FOG_REAL d0, FOG_REAL q_sun, const FOG_HP_T* p, int features) {
   const int rgb_channels = (features & FOG_HF_RGB) ? 3 : 1;
   const int falloff = (features & FOG_HF_FALLOFF) != 0;
-  FOG_REAL s0 = (features & FOG_HF_START) ? p[FOG_HP_START] : (FOG_REAL)0;
-  FOG_REAL s1 = (features & FOG_HF_CUTOFF) ? fmin(s_hit, p[FOG_HP_CUTOFF]) : s_hit;
-  FOG_INT sky_infinite = 0;
+  FOG_REAL s0 = (features & FOG_HF_START) ? (FOG_REAL)p[FOG_HP_START] : (FOG_REAL)0;
+  FOG_REAL s1 = (features & FOG_HF_CUTOFF) ? fmin(s_hit, (FOG_REAL)p[FOG_HP_CUTOFF]) : s_hit;
+  FOG_INT sky_infinite = 0, pass = 0;
   if (features & FOG_HF_SKYBOX) {
     /* §6.2: the sky is infinitely far in this mode, cut at s_cut where there is one. */
-    if (features & FOG_HF_CUTOFF) s1 = sky ? p[FOG_HP_CUTOFF] : s1;
+    if (features & FOG_HF_CUTOFF) s1 = sky ? (FOG_REAL)p[FOG_HP_CUTOFF] : s1;
     else sky_infinite = sky;
-  } else if (sky) {
-    return 0;
+  } else {
+    pass = sky;
   }
-  if (!sky_infinite && !(s1 > s0)) return 0;
-  FOG_REAL k = p[FOG_HP_K];
+  pass = pass | (!sky_infinite & !(s1 > s0));
+  FOG_REAL k = (FOG_REAL)p[FOG_HP_K];
   FOG_REAL h = FOG_NAME(fog_height_length)(s0, s1, wy, d0, k, falloff, sky_infinite);
   FOG_REAL h_sun = h, lobe = (FOG_REAL)0;
   if (features & FOG_HF_SUN) {
-    lobe = FOG_NAME(fog_sun_lobe)(q_sun, p[FOG_HP_SUN_EXP]);
+    lobe = FOG_NAME(fog_sun_lobe)(q_sun, (FOG_REAL)p[FOG_HP_SUN_EXP]);
     if (features & FOG_HF_SUN_START) {
-      FOG_REAL s0_sun = fmax(s0, p[FOG_HP_SUN_START]);
-      h_sun = sky_infinite || s1 > s0_sun ? FOG_NAME(fog_height_length)(s0_sun, s1, wy, d0, k, falloff, sky_infinite)
-                                          : (FOG_REAL)0;
+      FOG_REAL s0_sun = fmax(s0, (FOG_REAL)p[FOG_HP_SUN_START]);
+      h_sun = (sky_infinite | (s1 > s0_sun)) ? FOG_NAME(fog_height_length)(s0_sun, s1, wy, d0, k, falloff, sky_infinite)
+                                             : (FOG_REAL)0;
     }
   }
-  if (h == (FOG_REAL)0 && h_sun == (FOG_REAL)0) return 0;
+  FOG_INT fogged = !pass & !((h == (FOG_REAL)0) & (h_sun == (FOG_REAL)0));
   FOG_REAL t[3], j[3], j_sun[3];
   for (int c = 0; c < rgb_channels; ++c) {
-    t[c] = FOG_EXP(-FOG_NAME(fog_height_depth)(p[FOG_HP_EXT + c], h));
-    j[c] = -FOG_EXPM1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h));
-    j_sun[c] = (features & FOG_HF_SUN_START) ? -FOG_EXPM1(-FOG_NAME(fog_height_depth)(p[FOG_HP_IN + c], h_sun)) : j[c];
+    t[c] = FOG_EXP(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h));
+    j[c] = -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h));
+    j_sun[c] = (features & FOG_HF_SUN_START)
+                   ? -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h_sun))
+                   : j[c];
     if (features & FOG_HF_MAX_OPACITY) {
-      t[c] = fmax(t[c], p[FOG_HP_MIN_T]);
-      j[c] = fmin(j[c], p[FOG_HP_MAX]);
-      j_sun[c] = fmin(j_sun[c], p[FOG_HP_MAX]);
+      t[c] = fmax(t[c], (FOG_REAL)p[FOG_HP_MIN_T]);
+      j[c] = fmin(j[c], (FOG_REAL)p[FOG_HP_MAX]);
+      j_sun[c] = fmin(j_sun[c], (FOG_REAL)p[FOG_HP_MAX]);
     }
   }
   for (int c = 0; c < 3; ++c) {
     const int i = rgb_channels == 3 ? c : 0;
-    FOG_REAL sun = (features & FOG_HF_SUN) ? p[FOG_HP_SUN + c] * lobe * j_sun[i] : (FOG_REAL)0;
-    rgb[c] = FOG_NAME(fog_height_blend)(rgb[c], t[i], p[FOG_HP_FOG + c], j[i], sun);
+    FOG_REAL sun = (features & FOG_HF_SUN) ? (FOG_REAL)p[FOG_HP_SUN + c] * lobe * j_sun[i] : (FOG_REAL)0;
+    FOG_REAL fogged_c = FOG_NAME(fog_height_blend)(rgb[c], t[i], (FOG_REAL)p[FOG_HP_FOG + c], j[i], sun);
+    rgb[c] = fogged ? fogged_c : rgb[c];
   }
-  return 1;
+  return fogged;
 }
 /* Height fog's geometry of a pixel (docs/DESIGN.md §6.1), in view space: no rotation per pixel.
  * (cx, cy, cz): the pixel's corner ray (fog_bilerp of fog_ray_corners: at the far plane for raw
@@ -589,7 +598,6 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_geometry)(FOG_REAL raw, FOG_REAL cx, 
   return FOG_NAME(fog_view_distance)(raw, len, kind, 1, reversed_z, projection, 0, zx, zy, near_plane, far_plane,
                                      sky);
 }
-#endif /* !FOG_LANES16 */
 
 /* End of this instance: the includer's instance macros go, so the next instance can define its
  * own (FOG_EXP2 stays: it is written in terms of FOG_NAME). */

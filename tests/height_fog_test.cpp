@@ -269,6 +269,13 @@ TEST_P(HeightKernelVsReference, WithinBudget) {
       for (int k = 0; k < 3; ++k)
         ASSERT_EQ(e.rgb[k], ref.rgba[4 * (std::size_t(y) * f.color.width() + x) + k]) << x << "," << y;
     }
+  // PoCL's CPU device runs the same operations as scalar<float> (fma where written, IEEE
+  // selects): the same bits, whichever of its 16-lane blocks or one-pixel row tails a pixel is in.
+  std::size_t differing = 0;
+  for (std::size_t b = 0; b < out.size_bytes(); b += 4)
+    differing += std::memcmp(static_cast<const char*>(out.data()) + b, static_cast<const char*>(scalar_out.data()) + b, 4) != 0;
+  const bool same_bits_expected = runtime()->is_cpu() && c.precision == Precision::precise;
+  if (same_bits_expected) EXPECT_EQ(differing, 0u) << "kernel vs scalar<float> bits";
   Check kc = check_image(out, f.color, f.depth, cam, s, v);
   Check sc = check_image(scalar_out, f.color, f.depth, cam, s, v);
   // Half storage: the output's own rounding on top (one half ulp of the reference).
@@ -288,9 +295,9 @@ TEST_P(HeightKernelVsReference, WithinBudget) {
     kc = half_ulps(out);
     sc = half_ulps(scalar_out);
   }
-  std::printf("[ worst    ] %-44s %-60s kernel: err %.2e excess %.2e (allow %.1e) | scalar<float>: err %.2e excess %.2e\n",
+  std::printf("[ worst    ] %-44s %-60s kernel: err %.2e excess %.2e (allow %.1e) | scalar<float>: err %.2e excess %.2e | %zu floats differ\n",
               c.name, describe(v).c_str(), kc.worst_err, kc.worst_excess, kc.worst_allow, sc.worst_err,
-              sc.worst_excess);
+              sc.worst_excess, differing);
   EXPECT_EQ(kc.nonfinite, 0u);
   EXPECT_EQ(sc.nonfinite, 0u);
   // fast: -cl-fast-relaxed-math's built-ins have no ulp bound in the spec; measured, held to 4e-5.
@@ -301,6 +308,60 @@ TEST_P(HeightKernelVsReference, WithinBudget) {
 
 INSTANTIATE_TEST_SUITE_P(Variants, HeightKernelVsReference,
                          ::testing::Range(0, int(sizeof kCases / sizeof kCases[0])));
+
+// CPU devices: the 16-lane blocks (and one-pixel row tails) with the target's SIMD builtins and
+// the portable OpenCL C path give scalar<float>'s bits, in both storages; pass-through pixels (sky,
+// in front of the start) keep theirs, signalling NaNs included.
+TEST(HeightFog, CpuBlocksPortableAndTargetMatchScalarBitForBit) {
+  FOGCL_REQUIRE_DEVICE();
+  if (!runtime()->is_cpu()) GTEST_SKIP() << "not a CPU device";
+  CpuCodegen plain;
+  plain.target_intrinsics = false;
+  FogPass portable_pass(*runtime(), plain);
+  for (const ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
+    FogSettings s = settings_with(kFalloff | kRgb | kStart | kSun | kSunStart);
+    const CameraParams cam = posed(perspective(), {0.0f, 4.0f, 0.0f}, {0.1f, -0.05f, 1.0f});
+    Frame f = make_frame(67, 9, cam, format, 99);
+    // Signalling NaNs in the sky (passed through) and in front of the start.
+    for (int x = 0; x < 67; x += 5) {
+      f.depth.at(x, 2) = 1.0f;
+      f.depth.at(x, 3) = float((cam.far_plane() / 2.0 - cam.zbuffer_params.y) / cam.zbuffer_params.x);  // eye 2
+    }
+    if (format == ColorFormat::rgba32f)
+      for (int x = 0; x < 67; x += 5)
+        for (int y : {2, 3}) {
+          const std::uint32_t snan = 0x7fa00001u;
+          std::memcpy(f.color.rgba32f() + 4 * (std::size_t(y) * 67 + x), &snan, 4);
+        }
+    else
+      for (int x = 0; x < 67; x += 5)
+        for (int y : {2, 3}) f.color.rgba16f()[4 * (std::size_t(y) * 67 + x)] = 0x7d01;  // half sNaN
+    ColorImage target, portable, scalar;
+    shared_pass().apply(f.color, f.depth, target, cam, s);
+    portable_pass.apply(f.color, f.depth, portable, cam, s);
+    apply_fog_scalar(f.color, f.depth, scalar, cam, s);
+    std::size_t dt = 0, dp = 0, kept = 0;
+    const std::size_t bpp = bytes_per_pixel(format);
+    const auto* in = static_cast<const unsigned char*>(f.color.data());
+    for (std::size_t i = 0; i < f.depth.pixel_count(); ++i) {
+      dt += std::memcmp(static_cast<const unsigned char*>(target.data()) + i * bpp,
+                        static_cast<const unsigned char*>(scalar.data()) + i * bpp, bpp) != 0;
+      dp += std::memcmp(static_cast<const unsigned char*>(portable.data()) + i * bpp,
+                        static_cast<const unsigned char*>(scalar.data()) + i * bpp, bpp) != 0;
+      kept += std::memcmp(static_cast<const unsigned char*>(target.data()) + i * bpp, in + i * bpp, bpp) == 0;
+    }
+    std::printf("[ bits     ] %s: target %zu, portable %zu pixels differ from scalar<float>; %zu of %zu passed through\n",
+                to_string(format), dt, dp, kept, f.depth.pixel_count());
+    EXPECT_EQ(dt, 0u);
+    EXPECT_EQ(dp, 0u);
+    for (int x = 0; x < 67; x += 5)
+      for (int y : {2, 3})
+        EXPECT_EQ(std::memcmp(static_cast<const unsigned char*>(target.data()) + (std::size_t(y) * 67 + x) * bpp,
+                              in + (std::size_t(y) * 67 + x) * bpp, bpp),
+                  0)
+            << to_string(format) << " pixel " << x << "," << y << " must pass through bit for bit";
+  }
+}
 
 // The variant holds only what the scene uses.
 TEST(HeightVariant, BuildOptionsOnlyForWhatIsUsed) {

@@ -80,9 +80,7 @@ DeviceTraits device_traits(cl_device_id device, const CpuCodegen& codegen) {
 }
 
 int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }
-int pixels_per_work_item(const DeviceTraits& device, const Variant& variant) {
-  return variant.mode == KernelMode::height ? 1 : pixels_per_work_item(device);
-}
+int pixels_per_work_item(const DeviceTraits& device, const Variant&) { return pixels_per_work_item(device); }
 
 long long streaming_min_pixels(const DeviceTraits& device) {
   if (!device.cpu) return -1;  // GPUs: one pixel per work-item, their own store paths
@@ -137,7 +135,7 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
       if (v.height_features & (1 << bit)) o += std::string(" -D FOG_HEIGHT_") + kNames[bit];
   }
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device, v));
-  if (v.mode != KernelMode::height) o += streaming_store_option(device, v.storage);
+  o += streaming_store_option(device, v.storage);
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }

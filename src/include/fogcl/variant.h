@@ -99,8 +99,8 @@ std::string streaming_store_option(const DeviceTraits& device, ColorFormat stora
 
 // Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
 int pixels_per_work_item(const DeviceTraits& device);
-// Pixels each work-item of `variant` fogs: as above, but 1 everywhere for height fog (PoCL's
-// work-group vectoriser spreads its one-pixel work-items over the SIMD lanes).
+// Pixels each work-item of `variant` fogs: as above for every mode (height fog too: its formulas
+// run on 16 lanes like the others').
 int pixels_per_work_item(const DeviceTraits& device, const Variant& variant);
 
 // "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE ... -D FOG_VECTOR_WIDTH=16". Deterministic: equal
