@@ -51,6 +51,7 @@ Expr fog_exp2(const Expr& x) {
 //   target=host|avx512|skylake|avx2  host: the JIT host target less AVX512_SapphireRapids;
 //                avx512: only the AVX512 base feature; skylake: AVX512 + AVX512_Skylake; avx2: no AVX-512
 //   asserts=0    NoAsserts and NoBoundsQuery added to the target
+//   inplace=1    (read by the bench) the output written over its input
 struct Schedule {
   int vector = 16;
   int rows = 1;
@@ -239,6 +240,12 @@ Pipeline::Pipeline(const Variant& v, ColorFormat storage)
   target = s.target;
   pipeline = Halide::Pipeline(out);
   pipeline.compile_jit(target);
+  // FOGCL_HALIDE_ASM=DIR: the pipeline's assembly, to compare with PoCL's kernel.
+  if (const char* dir = std::getenv("FOGCL_HALIDE_ASM")) {
+    const std::string name = "fog_mode" + std::to_string(mode) + (v.distance ? "_distance" : "_depth") +
+                             (storage == ColorFormat::rgba16f ? "_f16" : "_f32");
+    pipeline.compile_to_assembly(std::string(dir) + "/" + name + ".s", pipeline.infer_arguments(), name, target);
+  }
 }
 
 using Key = std::tuple<int, bool, bool, bool, int, int>;
