@@ -40,6 +40,29 @@ std::vector<DemoSetting> demo_settings() {
   add("exp2-distance", FogMode::exp2, FogMetric::distance, false, false);
   add("exp-distance-fogsky", FogMode::exp, FogMetric::distance, true, false);
   add("linear-distance-revz", FogMode::linear, FogMetric::distance, false, true);
+  // Height fog (docs/DESIGN.md §6): a valley fog lying on the ground, a blue atmospheric haze with
+  // per-channel coefficients, and the same haze with a low sun's lobe ahead, against the sky.
+  FogSettings valley;
+  valley.mode = FogMode::height;
+  valley.color = glm::vec3(0.78f, 0.8f, 0.84f);
+  valley.density = 0.5f;
+  valley.height.falloff = 1.6f;
+  valley.height.base_height = 0.0f;
+  out.push_back({"height-valley", valley, false});
+  FogSettings haze;
+  haze.mode = FogMode::height;
+  haze.color = glm::vec3(0.42f, 0.58f, 0.86f);
+  haze.height.extinction = glm::vec3(0.006f, 0.011f, 0.024f);
+  haze.height.falloff = 0.04f;
+  haze.fog_skybox = true;
+  out.push_back({"height-haze-fogsky", haze, false});
+  FogSettings sun = haze;
+  SunLobe lobe;
+  lobe.direction = glm::vec3(0.35f, 0.12f, 1.0f);
+  lobe.color = glm::vec3(1.1f, 0.85f, 0.55f);
+  lobe.exponent = 24.0f;
+  sun.height.sun = lobe;
+  out.push_back({"height-sun-fogsky", sun, false});
   return out;
 }
 
@@ -84,6 +107,8 @@ int run_demo(const DemoOptions& o) {
       PerspectiveCamera camera;
       camera.reversed_z = d.reversed_z;
       frame = render_demo_scene(o.width, o.height, camera);
+      const DemoView view;  // the pose height fog needs (the other modes ignore it)
+      frame.params.pose = CameraPose{view.eye, view.target - view.eye, glm::vec3(0.0f, 1.0f, 0.0f)};
       rendered_z = int(d.reversed_z);
       const std::string tag = d.reversed_z ? "scene-revz" : "scene";
       write_exr_rgba(path(tag + ".exr"), frame.color);
