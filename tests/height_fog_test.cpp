@@ -363,6 +363,38 @@ TEST(HeightFog, CpuBlocksPortableAndTargetMatchScalarBitForBit) {
   }
 }
 
+// The integration API: the caller's context, queue and buffers; the same bits as apply(); an
+// enqueue without the pose is refused before anything is enqueued.
+TEST(HeightFog, IntegrationApiTakesThePoseAndMatchesApply) {
+  FOGCL_REQUIRE_DEVICE();
+  Runtime& rt = *runtime();
+  const cl::Context ctx = wrap(rt.context());
+  const cl::CommandQueue queue = wrap(rt.queue());
+  const CameraParams cam = posed(perspective(), {1.0f, 6.0f, -3.0f}, {0.2f, -0.1f, 1.0f});
+  Frame f = make_frame(37, 21, cam, ColorFormat::rgba32f, 5);
+  const FogSettings s = settings_with(kFalloff | kRgb | kSun | kSkybox);
+  cl::Buffer color_in(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.color.size_bytes(), f.color.data());
+  cl::Buffer depth(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, f.depth.size_bytes(), f.depth.data());
+  cl::Buffer color_out(ctx, CL_MEM_READ_WRITE, f.color.size_bytes());
+  FrameBuffers fb;
+  fb.width = 37;
+  fb.height = 21;
+  fb.color_in = color_in();
+  fb.depth = depth();
+  fb.color_out = color_out();
+  FogPass pass(rt.context(), rt.device());
+  pass.prepare(s, cam, ColorFormat::rgba32f);
+  CameraParams no_pose = cam;
+  no_pose.pose.reset();
+  EXPECT_MSG_HAS(error_of([&] { pass.enqueue(rt.queue(), fb, no_pose, s); }), "camera pose");
+  const cl::Event done = adopt(pass.enqueue(rt.queue(), fb, cam, s));
+  ColorImage got(37, 21);
+  queue.enqueueReadBuffer(color_out, CL_TRUE, 0, got.size_bytes(), got.data(), nullptr);
+  ColorImage want;
+  shared_pass().apply(f.color, f.depth, want, cam, s);
+  EXPECT_EQ(std::memcmp(got.data(), want.data(), got.size_bytes()), 0);
+}
+
 // The variant holds only what the scene uses.
 TEST(HeightVariant, BuildOptionsOnlyForWhatIsUsed) {
   const CameraParams cam = posed(perspective(), {0, 2, 0}, {0, 0, 1});
