@@ -256,7 +256,7 @@ TEST_F(CliCameraAndBudgetFlags, CameraFlagConflictsAreClearErrors) {
       {" --near 0.3 --far 1000 --ortho-size 5 --infinite-far", "--infinite-far"},
       {" --near 0.3 --far 1000 --fov 60 --precision fast --max-error 1", "not both"},
       {" --near 0.3 --far 1000 --fov 60 --max-error 1", "scalar"},
-      {" --near 0.3 --fov 60 --infinite-far --depth-kind eye", "perspective camera with a finite far"},
+      {" --near 0.3 --far 1000 --ortho-size 5 --depth-kind distance", "needs a perspective camera"},
   };
   for (const auto& c : cases) {
     const CliRun r = run_cli(base + c.args);
