@@ -75,6 +75,24 @@ std::vector<Scene> make_scenes(int w, int h) {
   add("dense-exp", standard, fog(FogMode::exp, FogMetric::distance, 1.0f, true));
   // density * d up to ~1e-4.
   add("thin-exp2", standard, fog(FogMode::exp2, FogMetric::distance, 1e-7f, true));
+  // Height fog (docs/DESIGN.md §6), as `fogcl demo`'s rows: a valley fog with falloff, and an
+  // atmospheric haze with per-channel coefficients, the sky fogged and a sun lobe.
+  FogSettings valley = fog(FogMode::height, FogMetric::distance, 0.5f, false);
+  valley.height.falloff = 1.6f;
+  add("height-valley", standard, valley);
+  FogSettings haze = fog(FogMode::height, FogMetric::distance, 0.0f, true);
+  haze.color = glm::vec3(0.42f, 0.58f, 0.86f);
+  haze.height.extinction = glm::vec3(0.006f, 0.011f, 0.024f);
+  haze.height.falloff = 0.04f;
+  SunLobe sun;
+  sun.direction = glm::vec3(0.35f, 0.12f, 1.0f);
+  sun.color = glm::vec3(1.1f, 0.85f, 0.55f);
+  sun.exponent = 24.0f;
+  haze.height.sun = sun;
+  add("height-haze-sun", standard, haze);
+  const DemoView view;  // the pose height fog needs (the other modes ignore it)
+  for (Scene& scene : out)
+    scene.frame.params.pose = CameraPose{view.eye, view.target - view.eye, glm::vec3(0.0f, 1.0f, 0.0f)};
   return out;
 }
 
@@ -167,7 +185,7 @@ std::string variant_name(bool scalar, Precision p, ColorFormat storage) {
 
 std::vector<std::string> report_scene_names() {
   return {"demo",           "wide-fov-120", "near0.01-far1e6-conventional", "near0.01-far1e6-reversed",
-          "dense-exp", "thin-exp2"};
+          "dense-exp", "thin-exp2", "height-valley", "height-haze-sun"};
 }
 
 Report run_report(const Runtime* runtime, const ReportOptions& o) {
@@ -188,6 +206,13 @@ Report run_report(const Runtime* runtime, const ReportOptions& o) {
     const double eye_err = scene.eye_depth_check ? eye_depth_rel_err(scene.frame.params) : -1.0;
     FogSettings probe_settings = scene.settings;
     probe_settings.color = glm::vec3(0.0f);
+    // Height fog: the probe (color 1, fog color 0, no sun) gives each channel's transmittance T,
+    // compared channel by channel (the reference's rgba), not against one factor per pixel.
+    const bool height = scene.settings.mode == FogMode::height;
+    if (height) probe_settings.height.sun.reset();
+    const auto probe_error = [&](const ColorImage& probe, const FogResult<double>& ref_probe) {
+      return height ? max_abs_rgb_error(probe, ref_probe) : max_abs_factor_error(probe, ref_probe);
+    };
     for (ColorFormat storage : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
       const ColorImage in = convert(scene.frame.color, storage);
       const ColorImage white = white_like(in);
@@ -206,7 +231,7 @@ Report run_report(const Runtime* runtime, const ReportOptions& o) {
           row.time_ms = device_run(*runtime, *pass, in, scene.frame.depth, out, scene.frame.params, s, o.runs);
           device_run(*runtime, *pass, white, scene.frame.depth, probe, scene.frame.params, ps, 0);
           color_errors(out, in, ref, row);
-          row.max_abs_err_factor = max_abs_factor_error(probe, ref_probe);
+          row.max_abs_err_factor = probe_error(probe, ref_probe);
           row.nonfinite += nonfinite_from_finite(probe, white);
           rows.push_back(row);
         }
@@ -219,7 +244,7 @@ Report run_report(const Runtime* runtime, const ReportOptions& o) {
         row.time_ms = scalar_run(in, scene.frame.depth, out, scene.frame.params, scene.settings, o.runs);
         apply_fog_scalar(white, scene.frame.depth, probe, scene.frame.params, probe_settings);
         color_errors(out, in, ref, row);
-        row.max_abs_err_factor = max_abs_factor_error(probe, ref_probe);
+        row.max_abs_err_factor = probe_error(probe, ref_probe);
         row.nonfinite += nonfinite_from_finite(probe, white);
         rows.push_back(row);
       }

@@ -51,7 +51,7 @@ struct Report {
 };
 
 // "demo", "wide-fov-120", "near0.01-far1e6-conventional", "near0.01-far1e6-reversed",
-// "dense-exp", "thin-exp2".
+// "dense-exp", "thin-exp2", "height-valley", "height-haze-sun" (height fog: docs/DESIGN.md §6).
 std::vector<std::string> report_scene_names();
 
 // Runs every precision variant (precise, fast) x storage (rgba32f, rgba16f) on `runtime`'s device
