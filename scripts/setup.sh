@@ -16,6 +16,11 @@ fi
 if [ "${1:-}" = "--bench" ]; then
   packages+=(python3-matplotlib libhalide14-0-dev)
 fi
+# --renderers: also Blender (Cycles), which the renderer tests render with (tests/blender; the
+# BlenderCamera tests of fogcl_tests run only where it is installed).
+if [ "${1:-}" = "--renderers" ]; then
+  packages+=(blender)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
