@@ -3,11 +3,12 @@
  * Variant switches, set by the host's build_options(); a variant holds no code for a feature the
  * scene does not use:
  *   FOG_MODE          1 linear, 2 linear hard step (start == end), 3 exp, 4 exp2, 5 height
- *                     (docs/DESIGN.md §6: along the ray, from the camera pose; one pixel per
- *                     work-item on every device, PoCL's work-group vectoriser spreads them)
- *   FOG_HEIGHT_FALLOFF, _RGB, _START, _CUTOFF, _MAX_OPACITY, _SUN, _SUN_START  height fog's parts
- *                     (fog_math.h FOG_HF_*): falloff k != 0, per-channel coefficients, start > 0,
- *                     a finite cut-off, maximum opacity < 1, the sun lobe, its own start
+ *                     (docs/DESIGN.md §6: along the ray, from the camera pose; 16-pixel blocks
+ *                     on CPU devices as the other modes, fog_height_pixels16)
+ *   FOG_HEIGHT_FALLOFF, _RGB, _START, _CUTOFF, _MAX_OPACITY, _SUN, _SUN_START, _SAME_IN  height
+ *                     fog's parts (fog_math.h FOG_HF_*): falloff k != 0, per-channel coefficients,
+ *                     start > 0, a finite cut-off, maximum opacity < 1, the sun lobe, its own
+ *                     start, in-scattering equal to extinction (T and J from one exponential)
  *   FOG_DISTANCE      distance-based fog (corner interpolation, and a sqrt but for exp2); else
  *                     depth-based
  *   FOG_SKYBOX        fog the skybox too (no sky test); else sky pixels keep f = 1
@@ -117,8 +118,13 @@
 #else
 #define FOG_HB_SUN_START 0
 #endif
+#ifdef FOG_HEIGHT_SAME_IN
+#define FOG_HB_SAME_IN 256
+#else
+#define FOG_HB_SAME_IN 0
+#endif
 #define FOG_HEIGHT_BITS (FOG_HB_FALLOFF | FOG_HB_RGB | FOG_HB_START | FOG_HB_CUTOFF | FOG_HB_MAX_OPACITY | \
-                         FOG_HB_SUN | FOG_HB_SUN_START | (FOG_USE_SKYBOX ? 128 : 0))
+                         FOG_HB_SUN | FOG_HB_SUN_START | FOG_HB_SAME_IN | (FOG_USE_SKYBOX ? 128 : 0))
 #endif
 #if FOG_VECTOR_WIDTH == 16
 #define FOG_CLAMP_BY_SELECT /* CPU devices: LLVM keeps IEEE comparisons (fog_sanitize_depth) */

@@ -372,6 +372,7 @@ FOG_FN FOG_REAL FOG_NAME(fog_blend)(FOG_REAL c, FOG_REAL fog_color, FOG_REAL f) 
 #define FOG_HF_SUN 32          /* the sun lobe */
 #define FOG_HF_SUN_START 64    /* the lobe's start s_sun > s_start */
 #define FOG_HF_SKYBOX 128      /* the sky is fogged, as an infinite ray (or up to s_cut) */
+#define FOG_HF_SAME_IN 256     /* beta_in == beta_ext: T and J from one exponential */
 /* Per-frame constants, in this order (fog_height_constants on the host). */
 #define FOG_HP_K 0           /* falloff k [1/world unit] */
 #define FOG_HP_START 1       /* s_start */
@@ -455,8 +456,19 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_log1p_neg_poly)(FOG_REAL y) {
   FOG_REAL log_u = fma(k, (FOG_REAL)0x1.62e4p-1f, fma(k, (FOG_REAL)0x1.7f7d1cp-20f, log_m));
   return u == (FOG_REAL)1 ? y : log_u * (y / (u - (FOG_REAL)1));
 }
+/* e^x and e^x - 1 of one x <= 0 from one reduction (T and J where beta_in == beta_ext): e^x is
+ * 2^n (1 + em), exactly what fog_exp_poly gives but below 2^-126 (0 here); e^x - 1 as
+ * fog_expm1_neg_poly. Returns e^x, writes e^x - 1. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_expm1_neg_poly)(FOG_REAL x, FOG_REAL* expm1_x) {
+  FOG_REAL n;
+  FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(fmax(x, (FOG_REAL)-87.0f), &n));
+  FOG_REAL s = FOG_NAME(fog_pow2i)(n);
+  *expm1_x = fma(s, em, s - (FOG_REAL)1);
+  return x < (FOG_REAL)-87.0f ? (FOG_REAL)0 : fma(s, em, s);
+}
 #ifdef __OPENCL_C_VERSION__
 #ifndef FOG_EXP
+#define FOG_EXP_EXPM1 FOG_NAME(fog_exp_expm1_neg_poly)
 #define FOG_EXP FOG_NAME(fog_exp_poly)
 #define FOG_EXPM1 FOG_NAME(fog_expm1_neg_poly)
 #define FOG_LOG1P FOG_NAME(fog_log1p_neg_poly)
@@ -549,8 +561,13 @@ FOG_FN_INLINE FOG_INT FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, 
   FOG_INT fogged = !pass & !((h == (FOG_REAL)0) & (h_sun == (FOG_REAL)0));
   FOG_REAL t[3], j[3], j_sun[3];
   for (int c = 0; c < rgb_channels; ++c) {
-    t[c] = FOG_EXP(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h));
-    j[c] = -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h));
+    if (features & FOG_HF_SAME_IN) {
+      t[c] = FOG_EXP_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h), &j[c]);
+      j[c] = -j[c];
+    } else {
+      t[c] = FOG_EXP(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h));
+      j[c] = -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h));
+    }
     j_sun[c] = (features & FOG_HF_SUN_START)
                    ? -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h_sun))
                    : j[c];

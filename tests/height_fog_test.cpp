@@ -175,6 +175,7 @@ FogSettings base_height_settings() {
 // The parts a case turns on.
 enum Parts : int {
   kFalloff = 1, kRgb = 2, kStart = 4, kCutoff = 8, kMaxOpacity = 16, kSun = 32, kSunStart = 64, kSkybox = 128,
+  kRgbSameIn = 256,  // per-channel extinction, in-scattering left to default to it
 };
 FogSettings settings_with(int parts) {
   FogSettings s = base_height_settings();
@@ -187,6 +188,7 @@ FogSettings settings_with(int parts) {
     h.extinction = glm::vec3(0.002f, 0.004f, 0.009f);
     h.inscattering = glm::vec3(0.001f, 0.003f, 0.0f);  // a zero channel
   }
+  if (parts & kRgbSameIn) h.extinction = glm::vec3(0.002f, 0.004f, 0.009f);
   if (parts & kStart) h.start = 30.0f;
   if (parts & kCutoff) h.cutoff = 600.0f;
   if (parts & kMaxOpacity) h.max_opacity = 0.8f;
@@ -239,6 +241,8 @@ const VariantCase kCases[] = {
      Precision::precise},
     {"falloff rgb skybox, eye depth", kFalloff | kRgb | kSkybox, cam_eye, ColorFormat::rgba32f, Precision::precise},
     {"falloff rgb sun skybox, rgba16f", kFalloff | kRgb | kSun | kSkybox, cam_persp, ColorFormat::rgba16f,
+     Precision::precise},
+    {"falloff rgb same-in sun skybox", kFalloff | kRgbSameIn | kSun | kSkybox, cam_persp, ColorFormat::rgba32f,
      Precision::precise},
     {"falloff rgb sun skybox, fast", kFalloff | kRgb | kSun | kSkybox, cam_persp, ColorFormat::rgba32f,
      Precision::fast},
@@ -401,7 +405,9 @@ TEST(HeightVariant, BuildOptionsOnlyForWhatIsUsed) {
   const std::string plain = build_options(select_variant(settings_with(0), cam, ColorFormat::rgba32f));
   std::printf("[ options  ] %s\n", plain.c_str());
   EXPECT_NE(plain.find("-D FOG_MODE=5"), std::string::npos);
-  EXPECT_EQ(plain.find("FOG_HEIGHT_"), std::string::npos);
+  // Grey, in-scattering = extinction: one exponential gives T and J; nothing else.
+  EXPECT_EQ(plain.find("FOG_HEIGHT_"), plain.find("FOG_HEIGHT_SAME_IN"));
+  EXPECT_EQ(plain.find("FOG_HEIGHT_", plain.find("FOG_HEIGHT_SAME_IN") + 1), std::string::npos);
   EXPECT_EQ(plain.find("FOG_SKYBOX"), std::string::npos);
   EXPECT_NE(plain.find("FOG_VECTOR_WIDTH=1"), std::string::npos);
   const std::string all = build_options(select_variant(settings_with(255), cam, ColorFormat::rgba16f));

@@ -48,6 +48,11 @@ inline float fog_log1p(float x);
 inline double fog_exp(double x) { return std::exp(x); }
 inline double fog_expm1(double x) { return std::expm1(x); }
 inline double fog_log1p(double x) { return std::log1p(x); }
+inline float fog_exp_expm1(float x, float* expm1_x);
+inline double fog_exp_expm1(double x, double* expm1_x) {
+  *expm1_x = std::expm1(x);
+  return std::exp(x);
+}
 
 #define FOG_INT int
 #define FOG_NAME(name) name
@@ -58,6 +63,7 @@ inline double fog_log1p(double x) { return std::log1p(x); }
 #define FOG_EXP fog_exp
 #define FOG_EXPM1 fog_expm1
 #define FOG_LOG1P fog_log1p
+#define FOG_EXP_EXPM1 fog_exp_expm1
 #define FOG_AS_INT fog_as_int
 #define FOG_CLAMP_BY_SELECT
 #include "fog_math.h"  // undefines the instance macros
@@ -65,12 +71,14 @@ inline double fog_log1p(double x) { return std::log1p(x); }
 #undef FOG_EXP
 #undef FOG_EXPM1
 #undef FOG_LOG1P
+#undef FOG_EXP_EXPM1
 #undef FOG_CLAMP_BY_SELECT
 
 inline float fog_exp2(float x) { return fog_exp2_poly(x); }
 inline float fog_exp(float x) { return fog_exp_poly(x); }
 inline float fog_expm1(float x) { return fog_expm1_neg_poly(x); }
 inline float fog_log1p(float x) { return fog_log1p_neg_poly(x); }
+inline float fog_exp_expm1(float x, float* expm1_x) { return fog_exp_expm1_neg_poly(x, expm1_x); }
 
 // The ray term of a pixel (fog_ray_term: |ray(u, v)|, or its square where `squared`): each
 // component interpolated from the frustum corners (fog_bilerp). The kernel composes the same

@@ -42,6 +42,7 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
       if (h.start > 0.0f) f |= kHeightStart;
       if (std::isfinite(h.cutoff)) f |= kHeightCutoff;
       if (h.max_opacity < 1.0f) f |= kHeightMaxOpacity;
+      if (in == ext) f |= kHeightSameIn;
       if (h.sun && h.sun->color != glm::vec3(0.0f) && in != glm::vec3(0.0f)) {
         f |= kHeightSun;
         if (h.sun->start > h.start) f |= kHeightSunStart;
@@ -130,9 +131,10 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
   if (v.mode == KernelMode::height) {
-    static const char* const kNames[] = {"FALLOFF", "RGB", "START", "CUTOFF", "MAX_OPACITY", "SUN", "SUN_START"};
-    for (int bit = 0; bit < 7; ++bit)
-      if (v.height_features & (1 << bit)) o += std::string(" -D FOG_HEIGHT_") + kNames[bit];
+    static const char* const kNames[] = {"FALLOFF", "RGB", "START", "CUTOFF", "MAX_OPACITY", "SUN", "SUN_START", "",
+                                         "SAME_IN"};
+    for (int bit = 0; bit < 9; ++bit)
+      if (bit != 7 && (v.height_features & (1 << bit))) o += std::string(" -D FOG_HEIGHT_") + kNames[bit];
   }
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device, v));
   o += streaming_store_option(device, v.storage);
@@ -157,8 +159,8 @@ std::string describe(const Variant& v) {
   std::string d = to_string(v.mode);
   if (v.mode == KernelMode::height) {
     static const char* const kNames[] = {" falloff", " rgb", " start", " cutoff", " max-opacity", " sun",
-                                         " sun-start"};
-    for (int bit = 0; bit < 7; ++bit)
+                                         " sun-start", "", " same-in"};
+    for (int bit = 0; bit < 9; ++bit)
       if (v.height_features & (1 << bit)) d += kNames[bit];
     if (!(v.height_features & kHeightFalloff)) d += " no-falloff";
     if (!(v.height_features & kHeightRgb)) d += " grey";

@@ -23,7 +23,7 @@ enum class KernelMode {
 
 // What a height-fog variant uses (Variant::height_features; kernels/fog_math.h FOG_HF_*), each
 // a build option of its own: FOG_HEIGHT_FALLOFF, _RGB, _START, _CUTOFF, _MAX_OPACITY, _SUN,
-// _SUN_START (the sky: FOG_SKYBOX).
+// _SUN_START, _SAME_IN (the sky: FOG_SKYBOX).
 enum HeightFeature : int {
   kHeightFalloff = 1,     // k != 0
   kHeightRgb = 2,         // per-channel coefficients (else grey: one channel computed)
@@ -32,6 +32,7 @@ enum HeightFeature : int {
   kHeightMaxOpacity = 16, // maximum opacity < 1
   kHeightSun = 32,        // the sun lobe
   kHeightSunStart = 64,   // the lobe starts after the fog's start
+  kHeightSameIn = 256,    // in-scattering == extinction in every channel: T and J from one exp
 };
 
 struct Variant {
