@@ -48,9 +48,10 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
         if (h.sun->start > h.start) f |= kHeightSunStart;
       }
       v.height_features = f;
-      // Always along the ray from the eye; the sky is an infinite ray (§6.2), never at the far plane.
+      // Always along the ray from the eye; the sky is an infinite ray (§6.2), never at the far plane,
+      // fogged with fog_skybox (which SkyDistance::infinite implies, as in the other modes).
       v.projection = camera.projection;
-      v.fog_skybox = s.fog_skybox;
+      v.fog_skybox = s.fog_skybox || s.sky == SkyDistance::infinite;
       v.reversed_z = camera.reversed_z;
       v.depth_kind = camera.depth_kind;
       v.storage = storage;
