@@ -199,29 +199,27 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
       fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v), FOG_DEPTH_KIND, FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx,
       k->zy, k->near_plane, k->far_plane, k->up.x, k->up.y, k->up.z, k->light.x, k->light.y, k->light.z,
       FOG_HB_SUN != 0, k->d0, &sky, &wy, &d0, &q_sun);
-  /* Element loads and stores, one store per channel whichever way the pixel goes: vload4 and
-   * vstore4 are calls in PoCL, and a call (or a store on one branch only) keeps its vectoriser off. */
-  global const COLOR_T* ci = color_in + 4 * i;
-  global COLOR_T* co = color_out + 4 * i;
+  /* GPUs (and CPU devices' row tails): the pixel as one vector load and store. */
 #ifdef FOG_COLOR_HALF
-  float rgb[3] = {vload_half(0, ci), vload_half(1, ci), vload_half(2, ci)};
-  if (fog_height_pixel(rgb, s_hit, sky, wy, d0, q_sun, k->hp, FOG_HEIGHT_BITS)) {
-    vstore_half_rte(rgb[0], 0, co);
-    vstore_half_rte(rgb[1], 1, co);
-    vstore_half_rte(rgb[2], 2, co);
-  } else {
-    /* Copy the bits: a half -> float -> half trip would quiet a signalling NaN. */
-    for (int c = 0; c < 3; ++c) ((global ushort*)co)[c] = ((global const ushort*)ci)[c];
-  }
-  ((global ushort*)co)[3] = ((global const ushort*)ci)[3]; /* alpha passes through */
+  const float4 c = vload_half4(i, color_in);
 #else
-  const float c0 = ci[0], c1 = ci[1], c2 = ci[2];
-  float rgb[3] = {c0, c1, c2};
-  const int fogged = fog_height_pixel(rgb, s_hit, sky, wy, d0, q_sun, k->hp, FOG_HEIGHT_BITS);
-  co[0] = fogged ? rgb[0] : c0;
-  co[1] = fogged ? rgb[1] : c1;
-  co[2] = fogged ? rgb[2] : c2;
-  co[3] = ci[3]; /* alpha passes through */
+  const float4 c = vload4(i, color_in);
+#endif
+  float rgb[3] = {c.x, c.y, c.z};
+  if (!fog_height_pixel(rgb, s_hit, sky, wy, d0, q_sun, k->hp, FOG_HEIGHT_BITS)) {
+#ifdef FOG_COLOR_HALF
+    /* Copy the bits: a half -> float -> half trip would quiet a signalling NaN. */
+    vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
+#else
+    vstore4(c, i, color_out);
+#endif
+    return;
+  }
+  const float4 o = (float4)(rgb[0], rgb[1], rgb[2], c.w /* alpha passes through */);
+#ifdef FOG_COLOR_HALF
+  vstore_half4_rte(o, i, color_out);
+#else
+  vstore4(o, i, color_out);
 #endif
 }
 #else
