@@ -51,11 +51,14 @@ Expr fog_exp2(const Expr& x) {
 //   target=host|avx512|skylake|avx2  host: the JIT host target less AVX512_SapphireRapids;
 //                avx512: only the AVX512 base feature; skylake: AVX512 + AVX512_Skylake; avx2: no AVX-512
 //   asserts=0    NoAsserts and NoBoundsQuery added to the target
+//   fuse=1       channels and pixels fused into one vectorised dimension (interleaved RGBA as
+//                loaded, the row's factors computed first and read at cx / 4)
 //   inplace=1    (read by the bench) the output written over its input
 struct Schedule {
   int vector = 16;
   int rows = 1;
   bool factor_at_vector = true;
+  bool fused = false;
   Halide::Target target;
 };
 
@@ -81,6 +84,7 @@ Schedule parse_schedule(const char* text) {
     if (key == "vec") s.vector = std::stoi(value);
     else if (key == "rows") s.rows = std::stoi(value);
     else if (key == "factor") s.factor_at_vector = value != "inline";
+    else if (key == "fuse") s.fused = value == "1";
     else if (key == "target") {
       const T base = s.target.without_feature(T::AVX512).without_feature(T::AVX512_Skylake)
                          .without_feature(T::AVX512_Cannonlake).without_feature(T::AVX512_SapphireRapids);
@@ -229,14 +233,24 @@ Pipeline::Pipeline(const Variant& v, ColorFormat storage)
   // stride-4 stores into one interleaved store), rows (or bands of s.rows rows) in parallel; the
   // factors of a vector computed once per vector (or inline, CSE'd across the unrolled channels).
   const Schedule& s = schedule();
-  out.reorder(c, x, y).bound(c, 0, 4).unroll(c).split(x, xo, xi, s.vector).vectorize(xi);
-  if (s.rows > 1) {
-    Var yo("yo"), yi("yi");
-    out.split(y, yo, yi, s.rows).parallel(yo);
+  Var yo("yo"), yi("yi");
+  const Var row = s.rows > 1 ? yi : y;  // the loop of one row
+  if (s.fused) {
+    // Channels and pixels as one dimension, 4 * s.vector lanes of interleaved RGBA a vector (no
+    // de- and re-interleaving), the factors of a row computed first and read at cx / 4.
+    Var cx("cx"), cxo("cxo"), cxi("cxi");
+    out.reorder(c, x, y).bound(c, 0, 4).fuse(c, x, cx).split(cx, cxo, cxi, 4 * s.vector).vectorize(cxi);
   } else {
-    out.parallel(y);
+    out.reorder(c, x, y).bound(c, 0, 4).unroll(c).split(x, xo, xi, s.vector).vectorize(xi);
   }
-  if (s.factor_at_vector) factor.compute_at(out, xo).vectorize(x, s.vector);
+  if (s.rows > 1)
+    out.split(y, yo, yi, s.rows).parallel(yo);
+  else
+    out.parallel(y);
+  if (s.fused)
+    factor.compute_at(out, row).vectorize(x, 16);
+  else if (s.factor_at_vector)
+    factor.compute_at(out, xo).vectorize(x, s.vector);
   target = s.target;
   pipeline = Halide::Pipeline(out);
   pipeline.compile_jit(target);
