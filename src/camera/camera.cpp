@@ -2,25 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "fogcl/error.h"
+#include "runtime/format.h"
 
 namespace fogcl {
 
 namespace {
-template <class T>
-std::string str(T v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v;
-  return s.str();
-}
-
-std::string str(const glm::vec3& v) { return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ")"; }
-std::string str(const glm::vec4& v) {
-  return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ", " + str(v.w) + ")";
-}
+using detail::str;
 
 // The one place the constants are computed from near and far (make_camera_params builds them,
 // validate checks handed-in ones against them). Float arithmetic, as Unity's

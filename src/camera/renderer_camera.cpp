@@ -1,25 +1,19 @@
 #include "fogcl/renderer_camera.h"
 
 #include <cmath>
-#include <sstream>
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
 
 #include "fogcl/error.h"
+#include "runtime/format.h"
 
 namespace fogcl {
 
 namespace {
 
-std::string str(double v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v;
-  return s.str();
-}
-std::string str(const glm::dvec3& v) { return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ")"; }
+using detail::str;
 
 constexpr double kPi = 3.14159265358979323846;
 // A rigid matrix's 3x3 part: columns of unit length and pairwise orthogonal to this much. Far

@@ -4,12 +4,12 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <sstream>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.h"
 #include "cli/volumes_cli.h"
+#include "runtime/format.h"
 
 namespace fogcl::cli {
 
@@ -18,12 +18,7 @@ namespace {
 const char* const kCameraFlags[] = {"--camera-to-world", "--axes",         "--focal-length",
                                     "--sensor-width",    "--sensor-height", "--sensor-fit"};
 
-std::string str(double v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v;
-  return s.str();
-}
+using detail::str;
 
 // A library message about `subject` ("axes must be ...", "camera-to-world matrix: ...") as the
 // flag's: "--axes must be ...", "--camera-to-world: ...".

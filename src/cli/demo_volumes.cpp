@@ -16,6 +16,7 @@
 #include "fogcl/demo_scene.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/volume_scalar.h"
+#include "runtime/format.h"
 
 namespace fogcl::cli {
 
@@ -41,13 +42,6 @@ const VolumeRow kRows[] = {
     {"volumes-physical-shadow", VolumeIntegrator::physical, true, false},
     {"volumes-shadow+exp2", VolumeIntegrator::stylized, true, true},
 };
-
-std::string vec(const glm::vec3& v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v.x << "," << v.y << "," << v.z;
-  return s.str();
-}
 
 }  // namespace
 
@@ -156,8 +150,9 @@ void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>
       "--shadow-map %s --light-view-proj %s\n",
       path("volumes-physical.json").c_str(), path("scene.exr").c_str(), path("scene-depth.exr").c_str(),
       double(camera.near_plane), double(camera.far_plane), double(camera.fov_y_deg), path("volumes.json").c_str(),
-      vec(scene.pose.eye).c_str(), vec(scene.pose.forward).c_str(), vec(scene.pose.up).c_str(),
-      vec(scene.light.direction).c_str(), vec(scene.light.color).c_str(), path("light-shadow.exr").c_str(),
+      detail::comma_list(scene.pose.eye).c_str(), detail::comma_list(scene.pose.forward).c_str(),
+      detail::comma_list(scene.pose.up).c_str(), detail::comma_list(scene.light.direction).c_str(),
+      detail::comma_list(scene.light.color).c_str(), path("light-shadow.exr").c_str(),
       matrix.str().c_str());
 }
 

@@ -23,6 +23,7 @@
 #include "fogcl/exr_io.h"
 #include "fogcl/volume_report.h"
 #include "fogcl/volume_scalar.h"
+#include "runtime/format.h"
 
 namespace fogcl::cli {
 
@@ -30,12 +31,7 @@ namespace {
 
 using nlohmann::json;
 
-std::string str(double v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v;
-  return s.str();
-}
+using detail::str;
 
 // ---- VOLUMES.json ----------------------------------------------------------------------------
 

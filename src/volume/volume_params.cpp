@@ -4,7 +4,6 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <sstream>
 
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
@@ -12,18 +11,13 @@
 
 #include "fogcl/error.h"
 #include "fogcl/volume_pass.h"
+#include "runtime/format.h"
 #include "volume/volume_formulas.h"
 
 namespace fogcl {
 
 namespace {
-std::string str(double v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v;
-  return s.str();
-}
-std::string str(const glm::vec3& v) { return "(" + str(v.x) + ", " + str(v.y) + ", " + str(v.z) + ")"; }
+using detail::str;
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -44,8 +38,7 @@ struct VolumeChecker {
   void color(const char* key, const glm::vec4& c) const {
     for (int k = 0; k < 4; ++k)
       if (!(std::isfinite(c[k]) && c[k] >= 0.0f && c[k] <= 65504.0f))
-        fail(key, "must be RGBA with each component in [0, 65504]",
-             "(" + str(c.r) + ", " + str(c.g) + ", " + str(c.b) + ", " + str(c.a) + ")");
+        fail(key, "must be RGBA with each component in [0, 65504]", str(c));
   }
 };
 constexpr float kInf = INFINITY;
