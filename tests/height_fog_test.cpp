@@ -399,6 +399,41 @@ TEST(HeightFog, IntegrationApiTakesThePoseAndMatchesApply) {
   EXPECT_EQ(std::memcmp(got.data(), want.data(), got.size_bytes()), 0);
 }
 
+// The float paths' exp, expm1 (x <= 0) and log1p (-1 < y <= 0) polynomials against the C
+// library in double, in ulps of the float result, on a sweep of their ranges (log1p's correction
+// y / (u - 1) adds two roundings to its log: 3 ulps).
+TEST(HeightFog, PolynomialsWithinTheirUlps) {
+  const auto ulps = [](float got, double want) {
+    if (want == 0) return got == 0 ? 0.0 : INFINITY;
+    const double ulp = std::ldexp(1.0, std::ilogb(float(want)) - 23);
+    return std::fabs(double(got) - want) / std::max(ulp, 0x1p-149);
+  };
+  double exp_worst = 0, expm1_worst = 0, log1p_worst = 0;
+  float exp_at = 0, expm1_at = 0, log1p_at = 0;
+  for (float x = -87.0f; x <= 88.0f; x = std::nextafter(x + 1e-2f * std::fabs(x) + 1e-5f, INFINITY)) {
+    const double e = ulps(formulas::fog_exp_poly(x), std::exp(double(x)));
+    if (e > exp_worst) exp_worst = e, exp_at = x;
+  }
+  for (float x = -1e-30f; x >= -40.0f; x *= 1.001f) {
+    const double e = ulps(formulas::fog_expm1_neg_poly(x), std::expm1(double(x)));
+    if (e > expm1_worst) expm1_worst = e, expm1_at = x;
+    float em;
+    const float t = formulas::fog_exp_expm1_neg_poly(x, &em);
+    EXPECT_EQ(em, formulas::fog_expm1_neg_poly(x)) << x;
+    if (x > -87.0f) EXPECT_LE(ulps(t, std::exp(double(x))), 2.0) << x;
+  }
+  for (float y = -1e-30f; y > -1.0f; y = std::min(y * 1.001f, std::nextafter(y, -1.0f))) {
+    if (y <= -0.999999f) break;
+    const double e = ulps(formulas::fog_log1p_neg_poly(y), std::log1p(double(y)));
+    if (e > log1p_worst) log1p_worst = e, log1p_at = y;
+  }
+  std::printf("[ ulps     ] exp %.2f (at %g), expm1 %.2f (at %g), log1p %.2f (at %g)\n", exp_worst, exp_at,
+              expm1_worst, expm1_at, log1p_worst, log1p_at);
+  EXPECT_LE(exp_worst, 2.0);
+  EXPECT_LE(expm1_worst, 2.0);
+  EXPECT_LE(log1p_worst, 3.5);
+}
+
 // The variant holds only what the scene uses.
 TEST(HeightVariant, BuildOptionsOnlyForWhatIsUsed) {
   const CameraParams cam = posed(perspective(), {0, 2, 0}, {0, 0, 1});
