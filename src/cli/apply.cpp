@@ -344,6 +344,12 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
     const Variant variant = select_variant(settings, params, color.color.format());
     std::fprintf(stderr, "device: %s\n", backend.name().c_str());
     std::fprintf(stderr, "camera: %s\n", job.camera_text.c_str());
+    if (settings.mode == FogMode::height && params.pose)  // --mode height: the pose its rays come from
+      std::fprintf(stderr, "height fog pose (fogcl's world): eye (%g, %g, %g), forward (%g, %g, %g), up (%g, %g, %g), from %s\n",
+                   double(params.pose->eye.x), double(params.pose->eye.y), double(params.pose->eye.z),
+                   double(params.pose->forward.x), double(params.pose->forward.y), double(params.pose->forward.z),
+                   double(params.pose->up.x), double(params.pose->up.y), double(params.pose->up.z),
+                   job.height_pose_from.c_str());
     std::fprintf(stderr, "depth: %s, channel %s%s\n", to_string(kind), o.depth_channel.c_str(),
                  color.deep ? " (deep color, flattened)" : "");
     std::fprintf(stderr, "%s", precision_why.c_str());
