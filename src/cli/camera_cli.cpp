@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.h"
+#include "cli/number_list.h"
 #include "cli/volumes_cli.h"
 #include "runtime/format.h"
 
@@ -33,24 +34,15 @@ bool has(const std::vector<std::string>& given, const std::string& flag) {
 
 // "m00,m01,...,m33": 16 finite numbers, or an error naming --camera-to-world and the element.
 std::array<double, 16> parse_sixteen(const std::string& text) {
-  std::array<double, 16> v{};
-  std::size_t n = 0, start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    char* end = nullptr;
-    const double d = std::strtod(part.c_str(), &end);
-    if (part.empty() || end == part.c_str() || *end != '\0')
-      throw Error("--camera-to-world element " + std::to_string(n) + " is not a number (got '" + part +
-                  "'; expected 16 comma-separated numbers m00,m01,...,m33, row by row)");
-    if (n < 16) v[n] = d;
-    ++n;
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (n != 16)
+  const NumberList list = parse_number_list(text);
+  if (list.bad_part)
+    throw Error("--camera-to-world element " + std::to_string(list.numbers.size()) + " is not a number (got '" +
+                *list.bad_part + "'; expected 16 comma-separated numbers m00,m01,...,m33, row by row)");
+  if (list.numbers.size() != 16)
     throw Error("--camera-to-world must be 16 comma-separated numbers m00,m01,...,m33, row by row (got " +
-                std::to_string(n) + ")");
+                std::to_string(list.numbers.size()) + ")");
+  std::array<double, 16> v{};
+  std::copy(list.numbers.begin(), list.numbers.end(), v.begin());
   return v;
 }
 

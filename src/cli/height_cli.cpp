@@ -2,15 +2,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.h"
+#include "cli/number_list.h"
 #include "cli/usage.h"
 #include "fogcl/renderer_camera.h"
+#include "runtime/format.h"
 
 namespace fogcl::cli {
 
@@ -19,11 +20,7 @@ namespace {
 const char* const kHeightFlags[] = {"--extinction", "--inscattering", "--height-falloff", "--base-height", "--cutoff",
                                     "--max-opacity", "--sun-color", "--sun-exponent", "--sun-start"};
 
-std::string shown(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.9g", v);
-  return b;
-}
+using detail::str;
 
 // One number (nan and inf read as such, for the rules to name them).
 double parse_number(const std::string& flag, const std::string& text) {
@@ -36,21 +33,10 @@ double parse_number(const std::string& flag, const std::string& text) {
 
 // "X,Y,Z" -> three numbers, or an error naming the flag.
 glm::dvec3 parse_triple(const std::string& flag, const std::string& text, const char* names = "X,Y,Z") {
-  std::vector<double> v;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    char* end = nullptr;
-    const double d = std::strtod(part.c_str(), &end);
-    if (part.empty() || end == part.c_str() || *end != '\0' || v.size() == 3)
-      throw Error(flag + " must be three comma-separated numbers " + names + " (got '" + text + "')");
-    v.push_back(d);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (v.size() != 3) throw Error(flag + " must be three comma-separated numbers " + names + " (got '" + text + "')");
-  return {v[0], v[1], v[2]};
+  const NumberList list = parse_number_list(text);
+  if (list.bad_part || list.numbers.size() != 3)
+    throw Error(flag + " must be three comma-separated numbers " + names + " (got '" + text + "')");
+  return {list.numbers[0], list.numbers[1], list.numbers[2]};
 }
 
 glm::vec3 non_negative_rgb(const std::string& flag, const std::string& text) {
@@ -134,7 +120,7 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
     if (given("--density")) throw Error("give either --density or --extinction, not both");
     h.extinction = non_negative_rgb("--extinction", o.extinction);
   } else if (!(std::isfinite(ap.settings.density) && ap.settings.density >= 0.0f)) {
-    throw Error("--density must be finite and >= 0 (got " + shown(ap.settings.density) + ")");
+    throw Error("--density must be finite and >= 0 (got " + str(ap.settings.density) + ")");
   }
   if (given("--inscattering")) h.inscattering = non_negative_rgb("--inscattering", o.inscattering);
   if (given("--height-falloff")) {
@@ -149,12 +135,12 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
   }
   if (given("--start")) {
     if (!(std::isfinite(ap.settings.start) && ap.settings.start >= 0.0f))
-      throw Error("--start must be finite and >= 0 with --mode height (got " + shown(ap.settings.start) + ")");
+      throw Error("--start must be finite and >= 0 with --mode height (got " + str(ap.settings.start) + ")");
     h.start = ap.settings.start;
   }
   if (given("--cutoff")) {
     const double c = parse_number("--cutoff", o.cutoff);
-    if (!(c > double(h.start))) throw Error("--cutoff must be > --start (got --cutoff " + o.cutoff + ", --start " + shown(h.start) + ")");
+    if (!(c > double(h.start))) throw Error("--cutoff must be > --start (got --cutoff " + o.cutoff + ", --start " + str(h.start) + ")");
     h.cutoff = float(c);
   }
   if (given("--max-opacity")) {

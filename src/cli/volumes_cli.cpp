@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/frame_memory.h"
+#include "cli/number_list.h"
 #include "cli/usage.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/volume_report.h"
@@ -395,23 +396,13 @@ namespace {
 
 // "X,Y,Z" -> three finite floats, or an error naming the flag.
 glm::vec3 parse_vec3(const std::string& flag, const std::string& text) {
-  std::vector<float> v;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    char* end = nullptr;
-    const double d = std::strtod(part.c_str(), &end);
-    if (part.empty() || end == part.c_str() || *end != '\0')
-      throw Error(flag + " must be three comma-separated numbers X,Y,Z (got '" + text + "')");
-    v.push_back(float(d));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  if (v.size() != 3) throw Error(flag + " must be three comma-separated numbers X,Y,Z (got '" + text + "')");
-  for (float x : v)
-    if (!std::isfinite(x)) throw Error(flag + " must be finite (got '" + text + "')");
-  return glm::vec3(v[0], v[1], v[2]);
+  const NumberList list = parse_number_list(text);
+  if (list.bad_part || list.numbers.size() != 3)
+    throw Error(flag + " must be three comma-separated numbers X,Y,Z (got '" + text + "')");
+  const glm::vec3 v(float(list.numbers[0]), float(list.numbers[1]), float(list.numbers[2]));
+  for (int k = 0; k < 3; ++k)  // as floats: 1e39 is inf
+    if (!std::isfinite(v[k])) throw Error(flag + " must be finite (got '" + text + "')");
+  return v;
 }
 
 const std::map<std::string, VolumeIntegrator> kIntegrators{{"stylized", VolumeIntegrator::stylized},
@@ -521,20 +512,11 @@ void note_given_volume_flags(const CLI::App& app, VolumeCliOptions& o) {
 }
 
 glm::mat4 parse_light_view_proj(const std::string& text) {
-  std::vector<double> v;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    char* end = nullptr;
-    const double d = std::strtod(part.c_str(), &end);
-    if (part.empty() || end == part.c_str() || *end != '\0')
-      throw Error("--light-view-proj element " + std::to_string(v.size()) + " is not a number (got '" + part +
-                  "'; expected 16 comma-separated numbers, row-major)");
-    v.push_back(d);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
+  const NumberList list = parse_number_list(text);
+  if (list.bad_part)
+    throw Error("--light-view-proj element " + std::to_string(list.numbers.size()) + " is not a number (got '" +
+                *list.bad_part + "'; expected 16 comma-separated numbers, row-major)");
+  const std::vector<double>& v = list.numbers;
   if (v.size() != 16)
     throw Error("--light-view-proj must be 16 comma-separated numbers, row-major (got " + std::to_string(v.size()) +
                 ")");

@@ -1,0 +1,39 @@
+// Comma-separated numbers on the command line ("1,0.5,2", 16 matrix elements): the splitting the
+// flags share; each flag keeps its own count, range and messages.
+#pragma once
+
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace fogcl::cli {
+
+struct NumberList {
+  std::vector<double> numbers;          // the parts read so far, in order
+  std::optional<std::string> bad_part;  // the first part that is not a number (index numbers.size())
+};
+
+// Each part between commas as strtod reads the whole of it (so nan, inf and 1e39 are numbers, for
+// the flag's rules to name them); stops at the first part that is empty or has anything after the
+// number.
+inline NumberList parse_number_list(const std::string& text) {
+  NumberList list;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    char* end = nullptr;
+    const double d = std::strtod(part.c_str(), &end);
+    if (part.empty() || end == part.c_str() || *end != '\0') {
+      list.bad_part = std::move(part);
+      return list;
+    }
+    list.numbers.push_back(d);
+    if (comma == std::string::npos) return list;
+    start = comma + 1;
+  }
+}
+
+}  // namespace fogcl::cli
