@@ -21,31 +21,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string vec3_text(const glm::vec3& v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v.x << "," << v.y << "," << v.z;
-  return s.str();
-}
-
-std::size_t differing_floats(const ColorImage& a, const ColorImage& b) {
-  if (a.size_bytes() != b.size_bytes()) return SIZE_MAX;
-  const auto* pa = static_cast<const unsigned char*>(a.data());
-  const auto* pb = static_cast<const unsigned char*>(b.data());
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < a.size_bytes(); i += 4) n += std::memcmp(pa + i, pb + i, 4) != 0;
-  return n;
-}
-
 class CliHeight : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = temp_dir() + "/cli-height-" + std::to_string(::getpid());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    frame_ = new DemoFrame(render_demo_scene(64, 36));
-    write_exr_rgba(in("scene.exr"), frame_->color);
-    write_exr_depth(in("scene-depth.exr"), frame_->depth);
+    dir_ = fresh_dir("cli-height");
+    frame_ = new DemoFrame(write_demo_scene(dir_, 64, 36));
   }
   static void TearDownTestSuite() { delete frame_; }
   static std::string in(const std::string& name) { return dir_ + "/" + name; }

@@ -37,13 +37,7 @@ std::string num9(double v) {
   s << v;
   return s.str();
 }
-std::string csv(const glm::vec3& v) { return num9(v.x) + "," + num9(v.y) + "," + num9(v.z); }
-std::string json3(const glm::vec3& v) { return "[" + csv(v) + "]"; }
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-}
+std::string json3(const glm::vec3& v) { return "[" + vec3_text(v) + "]"; }
 
 double max_abs_diff(const ColorImage& a, const ColorImage& b) {
   if (a.width() != b.width() || a.height() != b.height()) return INFINITY;
@@ -134,12 +128,8 @@ std::string camera_to_world_text(Axes axes) {
 class CliRendererCamera : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    dir_ = temp_dir() + "/cli-renderer-camera-" + std::to_string(::getpid());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    frame_ = new DemoFrame(render_demo_scene(kWidth, kHeight));
-    write_exr_rgba(in("scene.exr"), frame_->color);
-    write_exr_depth(in("scene-depth.exr"), frame_->depth);
+    dir_ = fresh_dir("cli-renderer-camera");
+    frame_ = new DemoFrame(write_demo_scene(dir_, kWidth, kHeight));
     shadow_ = new ShadowMap(render_demo_shadow_map(96, 96));
     write_exr_depth(in("shadow.exr"), shadow_->depth);
   }
@@ -168,9 +158,9 @@ class CliRendererCamera : public ::testing::Test {
     const MainLight light = demo_light();
     const std::string args = "apply --device scalar --color " + in("scene.exr") + " --depth " + in("scene-depth.exr") +
                              " --near 0.3 --far 1000 --fov 60 --time 2 --volumes " + volumes + " --light-dir " +
-                             csv(to_renderer(axes, light.direction)) + " --light-color " + csv(light.color) +
-                             " --shadow-map " + in("shadow.exr") + " --light-view-proj " + light_matrix_text(axes) +
-                             " " + camera + " --verbose --out " + in(out_name);
+                             vec3_text(to_renderer(axes, light.direction)) + " --light-color " +
+                             vec3_text(light.color) + " --shadow-map " + in("shadow.exr") + " --light-view-proj " +
+                             light_matrix_text(axes) + " " + camera + " --verbose --out " + in(out_name);
     fs::remove(in(out_name));
     const CliRun r = run_cli(args);
     EXPECT_EQ(r.exit_code, 0) << args << "\n" << r.output;
@@ -189,8 +179,8 @@ class CliRendererCamera : public ::testing::Test {
 // light direction and shadow matrix. A wrong conversion of any of them moves the fog.
 TEST_F(CliRendererCamera, RendererAxesGiveTheSameVolumesAsFogclsWorld) {
   const Basis b = demo_basis();
-  const std::string pose = "--eye " + csv(glm::vec3(b.eye)) + " --forward " + csv(glm::vec3(b.forward)) + " --up " +
-                           csv(glm::vec3(b.up));
+  const std::string pose = "--eye " + vec3_text(glm::vec3(b.eye)) + " --forward " + vec3_text(glm::vec3(b.forward)) +
+                           " --up " + vec3_text(glm::vec3(b.up));
   const ColorImage want = run(Axes::unity, pose, "fogcl.exr");
   ASSERT_GT(want.width(), 0);
   const double fogged = max_abs_diff(want, frame_->color);
@@ -211,8 +201,8 @@ TEST_F(CliRendererCamera, RendererAxesGiveTheSameVolumesAsFogclsWorld) {
   // --eye/--forward/--up in the renderer's world convert too.
   const auto r = [](const glm::dvec3& v) { return to_renderer(Axes::blender, glm::vec3(v)); };
   const ColorImage flags = run(Axes::blender,
-                               "--axes blender --eye " + csv(r(b.eye)) + " --forward " + csv(r(b.forward)) + " --up " +
-                                   csv(r(b.up)),
+                               "--axes blender --eye " + vec3_text(r(b.eye)) + " --forward " + vec3_text(r(b.forward)) +
+                                   " --up " + vec3_text(r(b.up)),
                                "blender-flags.exr");
   const double d = max_abs_diff(flags, want);
   std::printf("[ measured ] --axes blender --eye/--forward/--up vs fogcl's world: max |difference| %.3g\n", d);
@@ -337,14 +327,14 @@ TEST_F(CliRendererCamera, PoseFromTheColorFilesWorldToCamera) {
   const glm::dvec3 fogcl_axes[3] = {b.right, b.up, b.forward};
   const Imath::M44d w2c = w2c_of(fogcl_axes, b.eye);
   write_with_camera(in("with-camera.exr"), *frame_, w2c, w2c * c2n);
-  const std::string pose = "--eye " + csv(glm::vec3(b.eye)) + " --forward " + csv(glm::vec3(b.forward)) + " --up " +
-                           csv(glm::vec3(b.up));
+  const std::string pose = "--eye " + vec3_text(glm::vec3(b.eye)) + " --forward " + vec3_text(glm::vec3(b.forward)) +
+                           " --up " + vec3_text(glm::vec3(b.up));
   const ColorImage want = run(Axes::unity, pose, "flags.exr");
   std::string output;
   const MainLight light = demo_light();
-  const std::string common = " --device scalar --near 0.3 --far 1000 --time 2 --light-dir " + csv(light.direction) +
-                             " --light-color " + csv(light.color) + " --verbose --volumes " + in("volumes-unity.json") +
-                             " --shadow-map " + in("shadow.exr") +
+  const std::string common = " --device scalar --near 0.3 --far 1000 --time 2 --light-dir " +
+                             vec3_text(light.direction) + " --light-color " + vec3_text(light.color) +
+                             " --verbose --volumes " + in("volumes-unity.json") + " --shadow-map " + in("shadow.exr") +
                              " --light-view-proj " + light_matrix_text(Axes::unity);
   const CliRun r = run_cli("apply --color " + in("with-camera.exr") + common + " --out " + in("from-file.exr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -360,10 +350,10 @@ TEST_F(CliRendererCamera, PoseFromTheColorFilesWorldToCamera) {
   const Imath::M44d w2c_h = w2c_of(houdini_axes, h(b.eye));
   write_with_camera(in("houdini-camera.exr"), *frame_, w2c_h, w2c_h * c2n);
   const std::string houdini_common = " --device scalar --near 0.3 --far 1000 --time 2 --light-dir " +
-                                     csv(to_renderer(Axes::houdini, light.direction)) + " --light-color " +
-                                     csv(light.color) + " --volumes " +
-                                     in("volumes-houdini.json") + " --shadow-map " + in("shadow.exr") +
-                                     " --light-view-proj " + light_matrix_text(Axes::houdini);
+                                     vec3_text(to_renderer(Axes::houdini, light.direction)) + " --light-color " +
+                                     vec3_text(light.color) + " --volumes " + in("volumes-houdini.json") +
+                                     " --shadow-map " + in("shadow.exr") + " --light-view-proj " +
+                                     light_matrix_text(Axes::houdini);
   run(Axes::houdini, "--axes houdini --camera-to-world " + camera_to_world_text(Axes::houdini), "h.exr");  // writes the json
   const CliRun refused = run_cli("apply --color " + in("houdini-camera.exr") + houdini_common + " --out " + in("x.exr"));
   std::printf("[ message  ] %s", refused.output.c_str());
@@ -392,8 +382,9 @@ TEST_F(CliRendererCamera, PoseFromTheColorFilesWorldToCamera) {
 TEST_F(CliRendererCamera, OneKeyMediumEqualsTheSevenKeySpelling) {
   const Basis b = demo_basis();
   const std::string base = "apply --device scalar --color " + in("scene.exr") + " --depth " + in("scene-depth.exr") +
-                           " --near 0.3 --far 1000 --fov 60 --eye " + csv(glm::vec3(b.eye)) + " --forward " +
-                           csv(glm::vec3(b.forward)) + " --up " + csv(glm::vec3(b.up)) + " --light-dir 0.3,1,0.2";
+                           " --near 0.3 --far 1000 --fov 60 --eye " + vec3_text(glm::vec3(b.eye)) + " --forward " +
+                           vec3_text(glm::vec3(b.forward)) + " --up " + vec3_text(glm::vec3(b.up)) +
+                           " --light-dir 0.3,1,0.2";
   const std::string sphere = R"("center": [0.5, 1.5, 2], "radius": 3, "density": 0.7)";
   const std::string seven =
       R"("noise": false, "fade_edge": 0, "proximity_fade": 0, "fade_y": 0, "max_y": 3.4e38, )"

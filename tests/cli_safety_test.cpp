@@ -39,7 +39,6 @@ std::string read_bytes(const std::string& p) {
   return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
 }
 
-void write_text(const std::string& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
@@ -62,9 +61,7 @@ const std::string kFog = kNoFov + " --fov 60";
 class CliSafety : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    base_ = temp_dir() + "/cli-safety-" + std::to_string(::getpid());
-    fs::remove_all(base_);
-    fs::create_directories(base_);
+    base_ = fresh_dir("cli-safety");
     PerspectiveCamera camera;
     camera.fov_y_deg = 60.0f;
     const DemoFrame frame = render_demo_scene(64, 36, camera, DemoView{});
@@ -412,41 +409,6 @@ TEST_F(CliSafety, NamedTemporariesFitLongNamesAndSingleFilesSweepTheirOwn) {
 
 // ---- Signals with named temporaries ------------------------------------------------------------
 
-pid_t spawn(const std::string& args, const std::string& log) {
-  std::vector<std::string> words{cli_path()};
-  for (std::size_t at = 0; at < args.size();) {
-    const std::size_t end = std::min(args.find(' ', at), args.size());
-    if (end > at) words.push_back(args.substr(at, end - at));
-    at = end + 1;
-  }
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 1);
-    ::dup2(fd, 2);
-    ::setenv("FOGCL_TEMP_FILES", "named", 1);
-    restore_start_opencl_env();
-    std::vector<char*> argv;
-    for (std::string& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-// Whether `pid` has a named temporary open in `dir`.
-bool writing_in(pid_t pid, const std::string& dir) {
-  std::error_code ec;
-  for (fs::directory_iterator it("/proc/" + std::to_string(pid) + "/fd", ec), end; !ec && it != end; it.increment(ec)) {
-    std::error_code link_ec;
-    const std::string target = fs::read_symlink(it->path(), link_ec).string();
-    if (!link_ec && target.compare(0, dir.size() + 1, dir + "/") == 0 && target.find(".tmp-") != std::string::npos)
-      return true;
-  }
-  return false;
-}
-
 // How a run ended: "exit N" or "signal N".
 std::string ending(int status) {
   return WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
@@ -458,9 +420,9 @@ std::string ending(int status) {
 // False if the run ended before a write was caught.
 bool signal_mid_write(const std::string& args, const std::string& dir, const std::string& log,
                       const std::vector<int>& signals, int* status) {
-  const pid_t pid = spawn(args, log);
+  const pid_t pid = spawn_cli(args, log, true);
   for (;;) {
-    if (writing_in(pid, dir)) break;
+    if (writing_in(pid, dir, false)) break;  // a named temporary
     if (::waitpid(pid, status, WNOHANG) == pid) return false;
     std::this_thread::sleep_for(std::chrono::microseconds(100));
   }

@@ -24,18 +24,6 @@ namespace fs = std::filesystem;
 
 constexpr int kWidth = 64, kHeight = 36;
 
-std::string vec3_text(const glm::vec3& v) {
-  std::ostringstream s;
-  s.precision(9);
-  s << v.x << "," << v.y << "," << v.z;
-  return s.str();
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  f << text;
-}
-
 // The volumes of the test scene, as FogVolume and as the JSON text the CLI reads (written by hand
 // from the same numbers, so the parser is checked, not a writer's round trip).
 std::vector<FogVolume> test_volumes() {
@@ -79,26 +67,12 @@ const char* kVolumesJson = R"({
   ]
 })";
 
-// Bit-level comparison of two frames' RGBA; returns the number of differing floats.
-std::size_t differing_floats(const ColorImage& a, const ColorImage& b) {
-  if (a.width() != b.width() || a.height() != b.height() || a.size_bytes() != b.size_bytes()) return SIZE_MAX;
-  const auto* pa = reinterpret_cast<const std::uint32_t*>(a.data());
-  const auto* pb = reinterpret_cast<const std::uint32_t*>(b.data());
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < a.size_bytes() / 4; ++i) n += pa[i] != pb[i];
-  return n;
-}
-
 class CliVolumes : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     // One folder per process: ctest runs each test in its own process, in parallel.
-    dir_ = temp_dir() + "/cli-volumes-" + std::to_string(::getpid());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    frame_ = new DemoFrame(render_demo_scene(kWidth, kHeight));
-    write_exr_rgba(in("scene.exr"), frame_->color);
-    write_exr_depth(in("scene-depth.exr"), frame_->depth);
+    dir_ = fresh_dir("cli-volumes");
+    frame_ = new DemoFrame(write_demo_scene(dir_, kWidth, kHeight));
     write_text(in("volumes.json"), kVolumesJson);
     shadow_ = new ShadowMap(render_demo_shadow_map(128, 128));
     write_exr_depth(in("shadow.exr"), shadow_->depth);

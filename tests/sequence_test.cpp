@@ -644,44 +644,6 @@ TEST_F(Sequence, ADeviceThatFailsToOpenAfterTieredFramesStillFailsTheRun) {
 
 // ---- Killed runs -----------------------------------------------------------------------------------
 
-// The CLI started in the background, its output in `log`.
-pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries) {
-  std::vector<std::string> words{cli_path()};
-  for (std::size_t at = 0; at < args.size();) {
-    const std::size_t end = std::min(args.find(' ', at), args.size());
-    if (end > at) words.push_back(args.substr(at, end - at));
-    at = end + 1;
-  }
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 1);
-    ::dup2(fd, 2);
-    if (named_temporaries) ::setenv("FOGCL_TEMP_FILES", "named", 1);
-    restore_start_opencl_env();
-    std::vector<char*> argv;
-    for (std::string& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
-  return pid;
-}
-
-// Whether `pid` has a file open in `dir` for writing one: an O_TMPFILE inode shows as
-// "DIR/#INODE (deleted)", a named temporary as "DIR/NAME.tmp-...".
-bool writing_in(pid_t pid, const std::string& dir) {
-  std::error_code ec;
-  for (fs::directory_iterator it("/proc/" + std::to_string(pid) + "/fd", ec), end; !ec && it != end; it.increment(ec)) {
-    std::error_code link_ec;
-    const std::string target = fs::read_symlink(it->path(), link_ec).string();
-    if (!link_ec && target.compare(0, dir.size() + 1, dir + "/") == 0 &&
-        (target.find(".tmp-") != std::string::npos || target.find("(deleted)") != std::string::npos))
-      return true;
-  }
-  return false;
-}
-
 int exit_status(pid_t pid) {
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -695,7 +657,7 @@ bool signal_mid_write(const std::string& args, const std::string& out_dir, const
   const pid_t pid = spawn_cli(args, log, named);
   bool caught = false;
   for (;;) {
-    if (writing_in(pid, out_dir)) {
+    if (writing_in(pid, out_dir, true)) {
       ::kill(pid, signo);
       caught = true;
       break;

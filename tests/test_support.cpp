@@ -1,10 +1,13 @@
 #include "test_support.h"
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -15,6 +18,8 @@
 #include <random>
 
 #include <Imath/half.h>
+
+#include "fogcl/exr_io.h"
 
 namespace fogcl::test {
 
@@ -171,6 +176,29 @@ std::string num(float v) {
   return s.str();
 }
 
+std::string vec3_text(const glm::vec3& v) { return num(v.x) + "," + num(v.y) + "," + num(v.z); }
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  f << text;
+}
+
+std::size_t differing_floats(const ColorImage& a, const ColorImage& b) {
+  if (a.width() != b.width() || a.height() != b.height() || a.size_bytes() != b.size_bytes()) return SIZE_MAX;
+  const auto* pa = static_cast<const unsigned char*>(a.data());
+  const auto* pb = static_cast<const unsigned char*>(b.data());
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size_bytes(); i += 4) n += std::memcmp(pa + i, pb + i, 4) != 0;
+  return n;
+}
+
+DemoFrame write_demo_scene(const std::string& dir, int width, int height) {
+  DemoFrame frame = render_demo_scene(width, height);
+  write_exr_rgba(dir + "/scene.exr", frame.color);
+  write_exr_depth(dir + "/scene-depth.exr", frame.depth);
+  return frame;
+}
+
 const std::string& cli_path() {
   static const std::string path = [] {
     const char* env = std::getenv("FOGCL_TEST_CLI");
@@ -209,6 +237,42 @@ CliRun run_cli(const std::string& args, const std::string& env) {
   const int status = pclose(p);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries) {
+  std::vector<std::string> words{cli_path()};
+  for (std::size_t at = 0; at < args.size();) {
+    const std::size_t end = std::min(args.find(' ', at), args.size());
+    if (end > at) words.push_back(args.substr(at, end - at));
+    at = end + 1;
+  }
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    if (named_temporaries) ::setenv("FOGCL_TEMP_FILES", "named", 1);
+    restore_start_opencl_env();
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
+bool writing_in(pid_t pid, const std::string& dir, bool unnamed_too) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  for (fs::directory_iterator it("/proc/" + std::to_string(pid) + "/fd", ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code link_ec;
+    const std::string target = fs::read_symlink(it->path(), link_ec).string();
+    if (!link_ec && target.compare(0, dir.size() + 1, dir + "/") == 0 &&
+        (target.find(".tmp-") != std::string::npos || (unnamed_too && target.find("(deleted)") != std::string::npos)))
+      return true;
+  }
+  return false;
 }
 
 }  // namespace fogcl::test

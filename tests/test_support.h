@@ -2,12 +2,15 @@
 // measurement against the double reference.
 #pragma once
 
+#include <sys/types.h>
+
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "fogcl/demo_scene.h"
 #include "fogcl/fogcl.h"
 #include "runtime/clhpp.h"  // the tests drive OpenCL through fogcl's private CLHPP settings
 
@@ -104,6 +107,17 @@ std::string error_of(Fn&& fn) {
 
 // A float as the library formats it in messages (9 significant digits).
 std::string num(float v);
+// "x,y,z" with num's digits: a vector as the CLI's flags take it.
+std::string vec3_text(const glm::vec3& v);
+
+// `text` as the whole content of the file `path`.
+void write_text(const std::string& path, const std::string& text);
+// The number of 4-byte words (the RGBA floats) that differ between a and b; SIZE_MAX where their
+// sizes differ.
+std::size_t differing_floats(const ColorImage& a, const ColorImage& b);
+// The demo scene at width x height (render_demo_scene's defaults) written into `dir` as
+// scene.exr (RGBA) and scene-depth.exr.
+DemoFrame write_demo_scene(const std::string& dir, int width, int height);
 
 // The fogcl CLI run with `args` (and `env` assignments before it), stdout + stderr captured.
 struct CliRun {
@@ -111,6 +125,12 @@ struct CliRun {
   std::string output;
 };
 CliRun run_cli(const std::string& args, const std::string& env = "");
+// The fogcl CLI started in the background with `args` (split at spaces, no shell), stdout and
+// stderr into the file `log`; FOGCL_TEMP_FILES=named when named_temporaries. Returns its pid.
+pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries);
+// Whether process `pid` has a file open in `dir` for writing an output: a named temporary
+// ("DIR/NAME.tmp-..."), and with unnamed_too an O_TMPFILE inode (shown as "DIR/#INODE (deleted)").
+bool writing_in(pid_t pid, const std::string& dir, bool unnamed_too);
 
 }  // namespace fogcl::test
 
