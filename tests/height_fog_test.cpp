@@ -279,7 +279,9 @@ TEST_P(HeightKernelVsReference, WithinBudget) {
   for (std::size_t b = 0; b < out.size_bytes(); b += 4)
     differing += std::memcmp(static_cast<const char*>(out.data()) + b, static_cast<const char*>(scalar_out.data()) + b, 4) != 0;
   const bool same_bits_expected = runtime()->is_cpu() && c.precision == Precision::precise;
-  if (same_bits_expected) EXPECT_EQ(differing, 0u) << "kernel vs scalar<float> bits";
+  if (same_bits_expected) {
+    EXPECT_EQ(differing, 0u) << "kernel vs scalar<float> bits";
+  }
   Check kc = check_image(out, f.color, f.depth, cam, s, v);
   Check sc = check_image(scalar_out, f.color, f.depth, cam, s, v);
   // Half storage: the output's own rounding on top (one half ulp of the reference).
@@ -420,7 +422,9 @@ TEST(HeightFog, PolynomialsWithinTheirUlps) {
     float em;
     const float t = formulas::fog_exp_expm1_neg_poly(x, &em);
     EXPECT_EQ(em, formulas::fog_expm1_neg_poly(x)) << x;
-    if (x > -87.0f) EXPECT_LE(ulps(t, std::exp(double(x))), 2.0) << x;
+    if (x > -87.0f) {
+      EXPECT_LE(ulps(t, std::exp(double(x))), 2.0) << x;
+    }
   }
   for (float y = -1e-30f; y > -1.0f; y = std::min(y * 1.001f, std::nextafter(y, -1.0f))) {
     if (y <= -0.999999f) break;
