@@ -48,7 +48,7 @@ enum class DepthKind {
   distance,  // radial distance from the eye [world units] (|view-space position|); perspective only
 };
 
-// Where the camera is (docs/DESIGN.md §5.1; docs/volumetric.md §World and rays): Unity's world
+// Where the camera is (docs/volumetric.md §World and rays): Unity's world
 // space, left-handed, +y up. View space maps to world by the rotation with columns (right, up',
 // forward), right = normalize(cross(up, forward)), up' = cross(forward, right).
 struct CameraPose {
