@@ -487,7 +487,10 @@ void BM_OpenCLDevice(benchmark::State& state) {
     // timed after the loop: in the loop, another frame's worth of buffers written each iteration
     // would evict the pass's frame from the LLC, which the other paths' rows (one host copy after
     // each iteration) do not have to bear.
-    if (!rt->is_cpu()) copy_s += copy.seconds(queue);
+    // FOGCL_BENCH_DEVICE_COPY_EACH=1 restores the copy after each iteration on CPUs too (the A/B
+    // of docs/performance.md's ceiling section).
+    static const bool each = std::getenv("FOGCL_BENCH_DEVICE_COPY_EACH") != nullptr;
+    if (!rt->is_cpu() || each) copy_s += copy.seconds(queue);
     if (!rt->is_cpu()) {  // the result, for the error, once per run: a 4K read-back is ~10 ms
       if (!read_back) queue.enqueueReadBuffer(it->second.color_out, CL_TRUE, 0, out.size_bytes(), out.data());
       read_back = true;
@@ -500,7 +503,7 @@ void BM_OpenCLDevice(benchmark::State& state) {
     pass_s += seconds;
     return seconds;
   }, rt->is_cpu());
-  if (rt->is_cpu() && pass_s > 0) {
+  if (rt->is_cpu() && pass_s > 0 && copy_s == 0) {
     const cl::CommandQueue queue = wrap(rt->queue());
     for (int i = 0; i < 5; ++i) copy_s += copy.seconds(queue);
     copy_s *= double(state.iterations()) / 5.0;
