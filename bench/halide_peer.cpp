@@ -56,7 +56,7 @@ Expr fog_exp2(const Expr& x) {
 //   inplace=1    (read by the bench) the output written over its input
 struct Schedule {
   int vector = 16;
-  int rows = 1;
+  int rows = 4;
   bool factor_at_vector = true;
   bool fused = false;
   Halide::Target target;
@@ -230,14 +230,14 @@ Pipeline::Pipeline(const Variant& v, ColorFormat storage)
   out.output_buffer().dim(0).set_bounds(0, 4).set_stride(1);
   out.output_buffer().dim(1).set_stride(4);
   // Vectors of s.vector pixels over x, the four channels unrolled (Halide turns the four
-  // stride-4 stores into one interleaved store), rows (or bands of s.rows rows) in parallel; the
-  // factors of a vector computed once per vector (or inline, CSE'd across the unrolled channels).
+  // stride-4 stores into one interleaved store), bands of s.rows rows in parallel (or each row);
+  // the factors of a vector computed once per vector (or inline, CSE'd across the unrolled channels).
   const Schedule& s = schedule();
   Var yo("yo"), yi("yi");
   const Var row = s.rows > 1 ? yi : y;  // the loop of one row
   if (s.fused) {
-    // Channels and pixels as one dimension, 4 * s.vector lanes of interleaved RGBA a vector (no
-    // de- and re-interleaving), the factors of a row computed first and read at cx / 4.
+    // Channels and pixels as one dimension, 4 * s.vector lanes of interleaved RGBA a vector, the
+    // factors of a row computed first and read at cx / 4 (Halide still de-interleaves: slower).
     Var cx("cx"), cxo("cxo"), cxi("cxi");
     out.reorder(c, x, y).bound(c, 0, 4).fuse(c, x, cx).split(cx, cxo, cxi, 4 * s.vector).vectorize(cxi);
   } else {
@@ -333,3 +333,28 @@ extern "C" void fogcl_halide_copy(const void* src, void* dst, std::size_t row_by
   p.in.set(in);
   p.pipeline.realize(out, p.target);
 }
+
+// The schedule exploration behind Schedule's defaults (bench/halide_schedule_sweep.sh: each
+// schedule its own process, the schedules in turn, 3 rounds, medians in ms; BM_Halide RGBA32F,
+// Halide 14 JIT, HL_NUM_THREADS=2), on the 2-vCPU Xeon (skylake-avx512, 480 MiB L3, PoCL 3.1),
+// 2026-11-25 20:13-20:21 UTC, load 0.9-1.7 (bench/results/xeon-2core-ceiling-2026-11-25/).
+// 1080p, linear / exp2, depth / distance; "vs first" the median of the four ratios:
+//   vec=16 rows=1 (the earlier peer)  1.54 1.60 1.59 1.69   1.00
+//   vec=8                             1.59 1.71 1.84 1.97   1.12
+//   vec=32                            1.64 1.64 1.60 1.63   1.02
+//   rows=4                            1.42 1.43 1.52 1.57   0.93
+//   rows=16                           1.43 1.48 1.54 1.57   0.93
+//   factor=inline                     1.68 1.63 1.66 1.70   1.03
+//   fuse=1 (Halide still splits the channels: the per-channel selects de-interleave them, and the
+//          row of factors is a halide_malloc per row)
+//                                     1.88 2.04 2.23 2.29   1.32
+//   target=avx2                       2.49 2.69 2.73 2.88   1.70
+//   target=skylake                    1.64 1.66 1.61 1.67   1.03
+//   target=avx512                     1.55 1.73 1.64 1.70   1.02
+//   asserts=0                         1.52 1.62 1.64 1.65   1.00
+//   inplace=1 (output over its input) 1.53 1.61 1.72 1.84   1.05
+// Bands of rows, 1080p and 4K (the same four cases at each size), vs rows=1:
+//   rows=4 0.925, rows=8 0.960, rows=16 0.956, rows=32 0.944, rows=8 vec=32 0.941,
+//   rows=8 asserts=0 0.942; at 4K rows=4 took 10.3-11.6 ms against rows=1's 10.9-11.3.
+// Kept: 16 pixels a vector, bands of 4 rows a parallel task, the factors per vector, the host
+// target less AVX512_SapphireRapids, asserts on (no measurable cost), out of place.

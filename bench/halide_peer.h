@@ -1,6 +1,7 @@
 // The peer an image-pipeline engineer would write instead of an OpenCL pass: the deferred fog pass
-// in Halide 14, JIT-compiled for the host (bench/halide_peer.cpp). Parallel over rows, vectorised
-// by 16 pixels over x, interleaved RGBA32F or RGBA16F in and out, the sky test and the formulas of
+// in Halide 14, JIT-compiled for the host (bench/halide_peer.cpp). Parallel over bands of 4 rows,
+// vectorised by 16 pixels over x (the fastest schedule found: halide_peer.cpp's end), interleaved
+// RGBA32F or RGBA16F in and out, the sky test and the formulas of
 // kernels/fog_math.h written again as Halide expressions (a separate implementation, like
 // bench/openmp_peer.cpp; its error against the float64 path is measured in the bench). Built only
 // when CMake finds Halide (bench/CMakeLists.txt; `scripts/setup.sh --bench` installs it).
