@@ -32,7 +32,7 @@ def medians(benchmarks):
     """name -> (args dict, median run)"""
     found = {}
     for b in benchmarks:
-        if b.get("aggregate_name", "median") != "median":
+        if b.get("aggregate_name", "median") != "median" or b.get("error_occurred"):
             continue
         name = b["run_name"] if "run_name" in b else b["name"]
         parts = name.split("/")
