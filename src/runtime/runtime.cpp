@@ -34,9 +34,9 @@ struct Candidate {
 
 // PoCL's CPU device runs a work-group on whichever worker thread is free and lets the OS place its
 // threads; with POCL_AFFINITY=1 it pins worker i to CPU i. Pinned, the deferred pass took
-// 0.75-0.95x the kernel time at 1080p RGBA32F on the 2-vCPU Xeon (docs/performance.md, "The copy
-// ceiling and the Halide bar"): the two workers no longer share a core or migrate away from their
-// rows' lines. fogcl asks for it before the first platform query (PoCL reads it when its device
+// 0.71-0.81x the kernel time and 0.83-0.91x the whole call at 1080p RGBA32F on the 2-vCPU Xeon
+// (docs/performance.md, "The copy ceiling and the Halide bar"): the two workers no longer share a
+// core or migrate away from their rows' lines. fogcl asks for it before the first platform query (PoCL reads it when its device
 // starts), unless the environment sets POCL_AFFINITY itself or the process may not run on every
 // online CPU (taskset, cgroups, a batch scheduler's slot): PoCL pins by CPU number, which would
 // move its threads out of such a mask.
