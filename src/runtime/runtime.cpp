@@ -5,11 +5,6 @@
 #include <cstdlib>
 #include <vector>
 
-#if defined(__linux__)
-#include <sched.h>
-#include <unistd.h>
-#endif
-
 #include "runtime/clhpp.h"
 
 namespace fogcl {
@@ -32,38 +27,11 @@ struct Candidate {
   std::string label;  // "device name (platform name)"
 };
 
-// PoCL's CPU device runs a work-group on whichever worker thread is free and lets the OS place its
-// threads; with POCL_AFFINITY=1 it pins worker i to CPU i. Pinned, the deferred pass took
-// 0.71-0.81x the kernel time and 0.83-0.91x the whole call at 1080p RGBA32F on the 2-vCPU Xeon
-// (docs/performance.md, "The copy ceiling and the Halide bar"): the two workers no longer share a
-// core or migrate away from their rows' lines. fogcl asks for it before the first platform query (PoCL reads it when its device
-// starts), unless the environment sets POCL_AFFINITY itself or the process may not run on every
-// online CPU (taskset, cgroups, a batch scheduler's slot): PoCL pins by CPU number, which would
-// move its threads out of such a mask.
-void default_pocl_affinity() {
-#if defined(__linux__)
-  static const bool done = [] {
-    if (std::getenv("POCL_AFFINITY") != nullptr) return true;
-    cpu_set_t allowed;
-    CPU_ZERO(&allowed);
-    const long online = sysconf(_SC_NPROCESSORS_ONLN);
-    if (sched_getaffinity(0, sizeof allowed, &allowed) != 0 || online <= 0 || CPU_COUNT(&allowed) != online)
-      return true;
-    for (long cpu = 0; cpu < online; ++cpu)
-      if (!CPU_ISSET(cpu, &allowed)) return true;
-    setenv("POCL_AFFINITY", "1", 0);
-    return true;
-  }();
-  (void)done;
-#endif
-}
-
 // Platforms that failed to list their devices, with the CL error ("" if none): a driver that is
 // registered but does not come up (e.g. a GPU driver in a container without the device) is named
 // in find_device's message instead of vanishing from the list.
 std::vector<Candidate> all_devices(std::string* failed_platforms = nullptr) {
   std::vector<cl::Platform> platforms;
-  default_pocl_affinity();
   try {
     cl::Platform::get(&platforms);
   } catch (const cl::Error& e) {
