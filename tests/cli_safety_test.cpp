@@ -34,11 +34,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string read_bytes(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
 
 int lines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
 
@@ -68,7 +63,7 @@ class CliSafety : public ::testing::Test {
     write_exr_rgba(base_ + "/color.exr", frame.color);
     write_exr_depth(base_ + "/depth.exr", frame.depth);
     write_text(base_ + "/volumes.json", R"({"volumes": [{"center": [0, 1, 4], "radius": 2}]})");
-    write_text(base_ + "/shadow.exr", read_bytes(base_ + "/depth.exr"));
+    write_text(base_ + "/shadow.exr", read_text(base_ + "/depth.exr"));
   }
   static void TearDownTestSuite() { fs::remove_all(base_); }
   void SetUp() override {
@@ -101,7 +96,7 @@ TEST_F(CliSafety, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
   fs::create_symlink(path("depth.exr"), path("link-to-depth.exr"));
   fs::create_hard_link(path("depth.exr"), path("hard-depth.exr"));
   fs::create_hard_link(path("volumes.json"), path("hard-volumes.json"));
-  write_text(path("old-out.exr"), read_bytes(path("color.exr")));
+  write_text(path("old-out.exr"), read_text(path("color.exr")));
   fs::create_hard_link(path("old-out.exr"), path("hard-old-out.exr"));
   const std::string shadow = " --shadow-map " + path("shadow.exr") + " --light-view-proj 1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1";
   const std::string rel = fs::relative(path("depth.exr")).string();
@@ -131,7 +126,7 @@ TEST_F(CliSafety, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
       {"--out " + path("new.exr") + " --png " + dir_ + "/./new.exr", "is the same file as --out", ""},
   };
   for (const auto& c : cases) {
-    const std::string before = c.protects.empty() ? "" : read_bytes(path(c.protects));
+    const std::string before = c.protects.empty() ? "" : read_text(path(c.protects));
     const CliRun r = run_cli(apply(c.args));
     std::printf("[ refused  ] %s", r.output.c_str());
     EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
@@ -139,7 +134,7 @@ TEST_F(CliSafety, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
     EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << r.output;
     EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
     if (!c.protects.empty()) {
-      EXPECT_TRUE(read_bytes(path(c.protects)) == before) << c.protects << " changed";
+      EXPECT_TRUE(read_text(path(c.protects)) == before) << c.protects << " changed";
     }
     EXPECT_FALSE(fs::exists(path("o.exr")));
     EXPECT_FALSE(fs::exists(path("new.exr")));
@@ -153,7 +148,7 @@ TEST_F(CliSafety, AnOutputThatIsAnInputOrAnotherOutputIsRefused) {
 TEST_F(CliSafety, ASequenceFrameThatWouldReplaceAnInputIsRefused) {
   fs::copy_file(path("color.exr"), path("c.0001.exr"));
   fs::copy_file(path("depth.exr"), path("d.0001.exr"));
-  const std::string depth = read_bytes(path("d.0001.exr"));
+  const std::string depth = read_text(path("d.0001.exr"));
   const std::string seq = "apply --color " + path("c.####.exr") + " --depth " + path("d.####.exr") + kFog;
   const struct {
     std::string args, says;
@@ -168,30 +163,30 @@ TEST_F(CliSafety, ASequenceFrameThatWouldReplaceAnInputIsRefused) {
     EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
     EXPECT_EQ(lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
-    EXPECT_TRUE(read_bytes(path("d.0001.exr")) == depth) << "the depth frame changed";
+    EXPECT_TRUE(read_text(path("d.0001.exr")) == depth) << "the depth frame changed";
     EXPECT_FALSE(fs::exists(path("o.0001.exr")));
   }
-  const std::string color = read_bytes(path("c.0001.exr"));
+  const std::string color = read_text(path("c.0001.exr"));
   const CliRun r = run_cli(seq + " --out " + path("c.####.exr"));
   EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(read_bytes(path("c.0001.exr")), color) << "the color frame was not fogged in place";
+  EXPECT_NE(read_text(path("c.0001.exr")), color) << "the color frame was not fogged in place";
 }
 
 // Fogging --color in place stays allowed, also through a link; a link as --out is written
 // through (the file it names is replaced, the link stays).
 TEST_F(CliSafety, FoggingColorInPlaceStaysAllowed) {
-  const std::string before = read_bytes(path("color.exr"));
+  const std::string before = read_text(path("color.exr"));
   CliRun r = run_cli("apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --out " +
                      path("color.exr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string once = read_bytes(path("color.exr"));
+  const std::string once = read_text(path("color.exr"));
   EXPECT_NE(once, before) << "the color file was not fogged in place";
   fs::create_symlink(path("color.exr"), path("link.exr"));
   r = run_cli("apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --out " +
               path("link.exr"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::is_symlink(path("link.exr")));
-  EXPECT_NE(read_bytes(path("color.exr")), once) << "the file the link names was not fogged";
+  EXPECT_NE(read_text(path("color.exr")), once) << "the file the link names was not fogged";
   EXPECT_TRUE(temporaries_in(dir_).empty());
 }
 
@@ -278,7 +273,7 @@ TEST_F(CliSafety, ARewrittenOutputKeepsItsModeAndGroup) {
                   unsigned(st.st_mode & 07777), int(st.st_gid), int(other));
       EXPECT_EQ(st.st_mode & 07777, 0640u) << f;
       EXPECT_EQ(st.st_gid, other) << f;
-      EXPECT_NE(read_bytes(f), "old") << f << " was not rewritten";
+      EXPECT_NE(read_text(f), "old") << f << " was not rewritten";
     }
   }
   if (other == ::getegid()) std::printf("[ skipped  ] the group case: this user has no second group\n");
@@ -295,22 +290,22 @@ TEST_F(CliSafety, AFailedPreviewLeavesTheExrDestinationUntouched) {
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_EQ(lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find("the folder '" + path("missing") + "' does not exist"), std::string::npos) << r.output;
-    EXPECT_EQ(read_bytes(path("out.exr")), "the previous output");
+    EXPECT_EQ(read_text(path("out.exr")), "the previous output");
     // /proc takes no new file: the PNG fails when it is prepared, after the EXR was.
     r = run_cli(apply("--out " + path("out.exr") + " --png /proc/fogcl-safety-test.png"), mode);
     std::printf("[ refused  ] %s", r.output.c_str());
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_EQ(lines(r.output), 1) << r.output;
     EXPECT_NE(r.output.find("/proc/fogcl-safety-test.png: cannot write PNG"), std::string::npos) << r.output;
-    EXPECT_EQ(read_bytes(path("out.exr")), "the previous output");
+    EXPECT_EQ(read_text(path("out.exr")), "the previous output");
     EXPECT_TRUE(temporaries_in(dir_).empty());
     // In place: a rerun after such a failure must not fog twice.
-    const std::string color = read_bytes(path("color.exr"));
+    const std::string color = read_text(path("color.exr"));
     r = run_cli("apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --out " +
                     path("color.exr") + " --png /proc/fogcl-safety-test.png",
                 mode);
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_TRUE(read_bytes(path("color.exr")) == color) << "the color file was fogged although the run failed";
+    EXPECT_TRUE(read_text(path("color.exr")) == color) << "the color file was fogged although the run failed";
   }
 }
 
@@ -326,7 +321,7 @@ TEST_F(CliSafety, AWriteBatchCommitsAllOrNothing) {
     try {
       detail::WriteBatch batch;
       write(path("a.txt"), "new a");
-      EXPECT_EQ(read_bytes(path("a.txt")), "old a") << "replaced before the commit";
+      EXPECT_EQ(read_text(path("a.txt")), "old a") << "replaced before the commit";
       write(path("missing/b.txt"), "new b");
       batch.commit();
       ADD_FAILURE() << "the second write did not fail";
@@ -335,7 +330,7 @@ TEST_F(CliSafety, AWriteBatchCommitsAllOrNothing) {
       EXPECT_NE(std::string(e.what()).find("the folder '" + path("missing") + "' does not exist"), std::string::npos)
           << e.what();
     }
-    EXPECT_EQ(read_bytes(path("a.txt")), "old a");
+    EXPECT_EQ(read_text(path("a.txt")), "old a");
     EXPECT_TRUE(temporaries_in(dir_).empty());
     {
       detail::WriteBatch batch;
@@ -343,8 +338,8 @@ TEST_F(CliSafety, AWriteBatchCommitsAllOrNothing) {
       write(path("b.txt"), "new b");
       batch.commit();
     }
-    EXPECT_EQ(read_bytes(path("a.txt")), "new a");
-    EXPECT_EQ(read_bytes(path("b.txt")), "new b");
+    EXPECT_EQ(read_text(path("a.txt")), "new a");
+    EXPECT_EQ(read_text(path("b.txt")), "new b");
     EXPECT_TRUE(temporaries_in(dir_).empty());
     fs::remove(path("b.txt"));
     ::unsetenv("FOGCL_TEMP_FILES");
@@ -481,7 +476,7 @@ TEST_F(CliSafety, SignalsLeaveNoNamedTemporary) {
       std::printf("[ signal   ] %s: %s, %zu temporary file(s) left\n", c.what, ends.c_str(), left.size());
       for (const std::string& f : left) ADD_FAILURE() << "left behind: " << f;
     }
-    EXPECT_EQ(ends, c.ends) << read_bytes(path("log.txt"));
+    EXPECT_EQ(ends, c.ends) << read_text(path("log.txt"));
   }
 }
 

@@ -120,11 +120,6 @@ MeasuredRun run_measured(const std::string& args) {
 
 Imath::Box2i box(int x0, int y0, int x1, int y1) { return Imath::Box2i(Imath::V2i(x0, y0), Imath::V2i(x1, y1)); }
 
-std::vector<char> file_bytes(const std::string& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::vector<char>(std::istreambuf_iterator<char>(in), {});
-}
-
 // Sets a box2i attribute of an EXR header in place (the first part's).
 void patch_box(std::vector<char>& bytes, const std::string& name, const Imath::Box2i& b) {
   const std::string key = name + std::string(1, '\0') + "box2i" + std::string(1, '\0');

@@ -269,10 +269,6 @@ TEST_F(RendererExr, CameraFromTheFileAttributesAndFlagsWin) {
   EXPECT_FALSE(fs::exists(path("x.exr")));
 }
 
-std::vector<char> file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::vector<char>(std::istreambuf_iterator<char>(in), {});
-}
 void put_bytes(const std::string& path, const std::vector<char>& bytes, std::size_t size) {
   std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(std::min(size, bytes.size())));
 }

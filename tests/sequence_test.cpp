@@ -292,11 +292,6 @@ class Sequence : public ::testing::Test {
   std::string dir_;
 };
 
-std::vector<char> file_bytes(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-}
-
 TEST_F(Sequence, ThreadCountsAndThePipelineChangeNoByte) {
   make_frames(5, 64, 36);
   std::vector<std::string> devices{"scalar"};  // --threads 3: the scalar pass runs in row bands
@@ -671,11 +666,6 @@ bool signal_mid_write(const std::string& args, const std::string& out_dir, const
   }
   *status = exit_status(pid);
   return caught;
-}
-
-std::string read_text(const std::string& p) {
-  std::ifstream f(p);
-  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
 }
 
 TEST_F(Sequence, KillDashNineMidWriteLeavesOnlyCompleteFrames) {

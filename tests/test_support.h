@@ -112,6 +112,9 @@ std::string vec3_text(const glm::vec3& v);
 
 // `text` as the whole content of the file `path`.
 void write_text(const std::string& path, const std::string& text);
+// The whole content of the file `path`, byte for byte ("" / empty where it cannot be read).
+std::string read_text(const std::string& path);
+std::vector<char> file_bytes(const std::string& path);
 // The number of 4-byte words (the RGBA floats) that differ between a and b; SIZE_MAX where their
 // sizes differ.
 std::size_t differing_floats(const ColorImage& a, const ColorImage& b);
