@@ -34,15 +34,10 @@ bool has(const std::vector<std::string>& given, const std::string& flag) {
 
 // "m00,m01,...,m33": 16 finite numbers, or an error naming --camera-to-world and the element.
 std::array<double, 16> parse_sixteen(const std::string& text) {
-  const NumberList list = parse_number_list(text);
-  if (list.bad_part)
-    throw Error("--camera-to-world element " + std::to_string(list.numbers.size()) + " is not a number (got '" +
-                *list.bad_part + "'; expected 16 comma-separated numbers m00,m01,...,m33, row by row)");
-  if (list.numbers.size() != 16)
-    throw Error("--camera-to-world must be 16 comma-separated numbers m00,m01,...,m33, row by row (got " +
-                std::to_string(list.numbers.size()) + ")");
+  const std::vector<double> numbers =
+      parse_numbers("--camera-to-world", text, 16, "16 comma-separated numbers m00,m01,...,m33, row by row");
   std::array<double, 16> v{};
-  std::copy(list.numbers.begin(), list.numbers.end(), v.begin());
+  std::copy(numbers.begin(), numbers.end(), v.begin());
   return v;
 }
 

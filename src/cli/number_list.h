@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "fogcl/error.h"
+
 namespace fogcl::cli {
 
 struct NumberList {
@@ -34,6 +36,19 @@ inline NumberList parse_number_list(const std::string& text) {
     if (comma == std::string::npos) return list;
     start = comma + 1;
   }
+}
+
+// Exactly `count` numbers for `flag`, or one error naming the flag: "FLAG element I is not a number
+// (got 'X'; expected WHAT)" or "FLAG must be WHAT (got N)".
+inline std::vector<double> parse_numbers(const std::string& flag, const std::string& text, std::size_t count,
+                                         const std::string& what) {
+  NumberList list = parse_number_list(text);
+  if (list.bad_part)
+    throw Error(flag + " element " + std::to_string(list.numbers.size()) + " is not a number (got '" +
+                *list.bad_part + "'; expected " + what + ")");
+  if (list.numbers.size() != count)
+    throw Error(flag + " must be " + what + " (got " + std::to_string(list.numbers.size()) + ")");
+  return std::move(list.numbers);
 }
 
 }  // namespace fogcl::cli

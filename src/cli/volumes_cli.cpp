@@ -512,14 +512,7 @@ void note_given_volume_flags(const CLI::App& app, VolumeCliOptions& o) {
 }
 
 glm::mat4 parse_light_view_proj(const std::string& text) {
-  const NumberList list = parse_number_list(text);
-  if (list.bad_part)
-    throw Error("--light-view-proj element " + std::to_string(list.numbers.size()) + " is not a number (got '" +
-                *list.bad_part + "'; expected 16 comma-separated numbers, row-major)");
-  const std::vector<double>& v = list.numbers;
-  if (v.size() != 16)
-    throw Error("--light-view-proj must be 16 comma-separated numbers, row-major (got " + std::to_string(v.size()) +
-                ")");
+  const std::vector<double> v = parse_numbers("--light-view-proj", text, 16, "16 comma-separated numbers, row-major");
   glm::mat4 m(1.0f);
   for (int row = 0; row < 4; ++row)
     for (int col = 0; col < 4; ++col) {
