@@ -82,49 +82,50 @@
 #define FOG_EXP2 FOG_NAME(fog_exp2_poly)
 #endif
 #if FOG_MODE == 5
-/* Height fog's parts as fog_math.h's FOG_HF_* bit mask, a compile-time constant. */
+/* Height fog's parts as fog_math.h's FOG_HF_* bit mask, a compile-time constant (the names
+ * expand where used, after the include). */
 #ifdef FOG_HEIGHT_FALLOFF
-#define FOG_HB_FALLOFF 1
+#define FOG_HB_FALLOFF FOG_HF_FALLOFF
 #else
 #define FOG_HB_FALLOFF 0
 #endif
 #ifdef FOG_HEIGHT_RGB
-#define FOG_HB_RGB 2
+#define FOG_HB_RGB FOG_HF_RGB
 #else
 #define FOG_HB_RGB 0
 #endif
 #ifdef FOG_HEIGHT_START
-#define FOG_HB_START 4
+#define FOG_HB_START FOG_HF_START
 #else
 #define FOG_HB_START 0
 #endif
 #ifdef FOG_HEIGHT_CUTOFF
-#define FOG_HB_CUTOFF 8
+#define FOG_HB_CUTOFF FOG_HF_CUTOFF
 #else
 #define FOG_HB_CUTOFF 0
 #endif
 #ifdef FOG_HEIGHT_MAX_OPACITY
-#define FOG_HB_MAX_OPACITY 16
+#define FOG_HB_MAX_OPACITY FOG_HF_MAX_OPACITY
 #else
 #define FOG_HB_MAX_OPACITY 0
 #endif
 #ifdef FOG_HEIGHT_SUN
-#define FOG_HB_SUN 32
+#define FOG_HB_SUN FOG_HF_SUN
 #else
 #define FOG_HB_SUN 0
 #endif
 #ifdef FOG_HEIGHT_SUN_START
-#define FOG_HB_SUN_START 64
+#define FOG_HB_SUN_START FOG_HF_SUN_START
 #else
 #define FOG_HB_SUN_START 0
 #endif
 #ifdef FOG_HEIGHT_SAME_IN
-#define FOG_HB_SAME_IN 256
+#define FOG_HB_SAME_IN FOG_HF_SAME_IN
 #else
 #define FOG_HB_SAME_IN 0
 #endif
 #define FOG_HEIGHT_BITS (FOG_HB_FALLOFF | FOG_HB_RGB | FOG_HB_START | FOG_HB_CUTOFF | FOG_HB_MAX_OPACITY | \
-                         FOG_HB_SUN | FOG_HB_SUN_START | FOG_HB_SAME_IN | (FOG_USE_SKYBOX ? 128 : 0))
+                         FOG_HB_SUN | FOG_HB_SUN_START | FOG_HB_SAME_IN | (FOG_USE_SKYBOX ? FOG_HF_SKYBOX : 0))
 #endif
 #if FOG_VECTOR_WIDTH == 16
 #define FOG_CLAMP_BY_SELECT /* CPU devices: LLVM keeps IEEE comparisons (fog_sanitize_depth) */
