@@ -298,6 +298,15 @@ static inline void fog_height_pixels16(global const COLOR_T* color_in, global co
 #define fog_pixels16 fog_height_pixels16
 #endif
 
+#if FOG_MODE == FOG_MODE_HEIGHT
+/* A float4's x, y, z into three entries of the FOG_HP_* block. */
+static inline void fog_put_rgb(float* p, float4 v) {
+  p[0] = v.x;
+  p[1] = v.y;
+  p[2] = v.z;
+}
+#endif
+
 kernel void deferred_fog(global const COLOR_T* color_in, global const float* depth,
                          global COLOR_T* color_out, int width, int height,
                          float4 zbuffer_params, float4 projection_params, float4 corner_bl,
@@ -332,18 +341,10 @@ kernel void deferred_fog(global const COLOR_T* color_in, global const float* dep
   k.hp[FOG_HP_SUN_EXP] = height_b.y;
   k.hp[FOG_HP_SUN_START] = height_b.z;
   k.d0 = height_b.w;
-  k.hp[FOG_HP_EXT + 0] = extinction.x;
-  k.hp[FOG_HP_EXT + 1] = extinction.y;
-  k.hp[FOG_HP_EXT + 2] = extinction.z;
-  k.hp[FOG_HP_IN + 0] = inscattering.x;
-  k.hp[FOG_HP_IN + 1] = inscattering.y;
-  k.hp[FOG_HP_IN + 2] = inscattering.z;
-  k.hp[FOG_HP_FOG + 0] = fog_color.x;
-  k.hp[FOG_HP_FOG + 1] = fog_color.y;
-  k.hp[FOG_HP_FOG + 2] = fog_color.z;
-  k.hp[FOG_HP_SUN + 0] = sun_color.x;
-  k.hp[FOG_HP_SUN + 1] = sun_color.y;
-  k.hp[FOG_HP_SUN + 2] = sun_color.z;
+  fog_put_rgb(k.hp + FOG_HP_EXT, extinction);
+  fog_put_rgb(k.hp + FOG_HP_IN, inscattering);
+  fog_put_rgb(k.hp + FOG_HP_FOG, fog_color);
+  fog_put_rgb(k.hp + FOG_HP_SUN, sun_color);
   k.up = up_view;
   k.light = light_view;
 #endif
