@@ -17,6 +17,9 @@
 //                        kernel's profiling time; call_vs_kernel: the call over it, same iterations
 //   BM_DeviceCopy        clEnqueueCopyBuffer of the pass's color and depth into device buffers
 //                        (profiling events): the device's own bandwidth ceiling, for GPUs
+//   BM_PinnedTransfer    the bytes a host round trip moves (color and depth up, color down) between
+//                        host memory and device buffers, from pageable (host 0) or pinned (host 1)
+//                        memory: the bus's ceiling of BM_OpenCLHostCall and BM_VolumeHostCall
 //   BM_OpenCLDeviceCacheResident  BM_OpenCLDevice on a 512x256 frame that stays in the caches
 //                        (its compute cost; BM_Memcpy also runs at 512x256)
 // Counters: bytes_per_second; vs_copy = ceiling_ms / (this time), ceiling_ms the fastest 2-thread
@@ -525,6 +528,78 @@ void BM_DeviceCopy(benchmark::State& state) {
   state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(copy.bytes_moved()));
 }
 
+// The bus's ceiling of a host round trip: a frame's input bytes (color_in and depth) written to
+// device buffers, then its output bytes (color_out) read back, on the pass's device and queue
+// (FOGCL_DEVICE). Both passes' convenience calls (FogPass::apply, VolumePass::apply) move exactly
+// these three buffers, so one row per frame size and storage serves both. Range "host": where the
+// host side lives, 0 ordinary pageable memory (a page-aligned allocation, touched before the
+// loop), 1 pinned memory (three CL_MEM_ALLOC_HOST_PTR buffers mapped once, the mapped pointers the
+// source and destination of clEnqueueWriteBuffer / clEnqueueReadBuffer, the usual way to get
+// page-locked memory in OpenCL). Device buffers are made once, outside the loop. Time: wall clock
+// from the first write's enqueue to the clFinish after the read; the host waits (clFinish) once
+// between the writes and the read, so that each direction is timed on its own (up_ms, down_ms).
+// Counters: up_ms, down_ms, GBps = the bytes moved / the time, bytes = the bytes moved per
+// iteration (color_in + depth + color_out).
+void BM_PinnedTransfer(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  const int w = int(state.range(0)), h = int(state.range(1));
+  const ColorFormat format = state.range(2) ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+  const bool pinned = state.range(3) != 0;
+  const std::size_t color_bytes = std::size_t(w) * std::size_t(h) * bytes_per_pixel(format);
+  const std::size_t depth_bytes = std::size_t(w) * std::size_t(h) * sizeof(float);
+  const std::size_t bytes = 2 * color_bytes + depth_bytes;
+  const cl::Context ctx = wrap(rt->context());
+  const cl::CommandQueue queue = wrap(rt->queue());
+  const cl::Buffer dev_color_in(ctx, CL_MEM_READ_ONLY, color_bytes), dev_depth(ctx, CL_MEM_READ_ONLY, depth_bytes);
+  const cl::Buffer dev_color_out(ctx, CL_MEM_WRITE_ONLY, color_bytes);
+  // The host side: three regions, the inputs' sources and the output's destination.
+  const std::size_t sizes[3] = {color_bytes, depth_bytes, color_bytes};
+  void* host[3] = {};
+  cl::Buffer staging[3];  // pinned: the CL_MEM_ALLOC_HOST_PTR buffers behind host[]
+  std::unique_ptr<void, decltype(&std::free)> pageable[3] = {{nullptr, std::free}, {nullptr, std::free}, {nullptr, std::free}};
+  constexpr std::size_t kPage = 4096;
+  for (int i = 0; i < 3; ++i) {
+    if (pinned) {
+      staging[i] = cl::Buffer(ctx, CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR, sizes[i]);
+      host[i] = queue.enqueueMapBuffer(staging[i], CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, sizes[i]);
+    } else {
+      pageable[i].reset(std::aligned_alloc(kPage, (sizes[i] + kPage - 1) / kPage * kPage));
+      if (!pageable[i]) return state.SkipWithError("cannot allocate the pageable host memory");
+      host[i] = pageable[i].get();
+    }
+    std::memset(host[i], 0x3c, sizes[i]);  // first touch, outside the timing
+  }
+  double up = 0, down = 0;
+  const auto round_trip = [&] {
+    const auto a = Clock::now();
+    queue.enqueueWriteBuffer(dev_color_in, CL_FALSE, 0, color_bytes, host[0]);
+    queue.enqueueWriteBuffer(dev_depth, CL_FALSE, 0, depth_bytes, host[1]);
+    queue.finish();
+    const auto b = Clock::now();
+    queue.enqueueReadBuffer(dev_color_out, CL_FALSE, 0, color_bytes, host[2]);
+    queue.finish();
+    const auto c = Clock::now();
+    return std::pair{std::chrono::duration<double>(b - a).count(), std::chrono::duration<double>(c - b).count()};
+  };
+  round_trip();  // the device buffers' first use (allocation on first touch), not timed
+  for (auto _ : state) {
+    const auto [u, d] = round_trip();
+    up += u;
+    down += d;
+    state.SetIterationTime(u + d);
+  }
+  for (int i = 0; i < 3; ++i)
+    if (pinned) queue.enqueueUnmapMemObject(staging[i], host[i]);
+  queue.finish();
+  const double n = double(state.iterations());
+  state.counters["up_ms"] = up / n * 1e3;
+  state.counters["down_ms"] = down / n * 1e3;
+  state.counters["GBps"] = double(bytes) * n / (up + down) * 1e-9;
+  state.counters["bytes"] = double(bytes);
+  state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(bytes));
+}
+
 void BM_OpenCLHostCall(benchmark::State& state) {
   Runtime* rt = runtime(state);
   if (rt == nullptr) return;
@@ -932,6 +1007,13 @@ BENCHMARK(BM_DeviceCopy)
     ->ArgNames({"w", "h", "f16"})
     ->ArgsProduct({{1920}, {1080}, {0, 1}})
     ->ArgsProduct({{3840}, {2160}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2);
+BENCHMARK(BM_PinnedTransfer)
+    ->ArgNames({"w", "h", "f16", "host"})
+    ->ArgsProduct({{1920}, {1080}, {0, 1}, {0, 1}})
+    ->ArgsProduct({{3840}, {2160}, {0, 1}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2);

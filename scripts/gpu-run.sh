@@ -6,7 +6,8 @@
 # with nvidia.icd next to the machine's own .icd files, e.g. its PoCL), links from the bundle
 # only the libraries the machine lacks, then
 #   tests  the whole test suite with FOGCL_DEVICE=gpu, in parallel shards (gtest XML per shard)
-#   bench  both benchmarks on the GPU (device-resident and host round trip, the device copy)
+#   bench  both benchmarks on the GPU (device-resident and host round trip, the device copy, the
+#          pinned and pageable transfer of a round trip's bytes in the round trip's run)
 #   pocl   the volumetric march on the machine's PoCL, 1 to all cores (POCL_MAX_PTHREAD_COUNT)
 #   sequence  fogcl apply on frame sequences against OpenEXR alone (sequence_bench.py; not in
 #          "all": minutes of I/O; SEQUENCE_ARGS adds its options, e.g. "--cases 4k-half-zip")
@@ -83,7 +84,7 @@ bench() {  # bench BINARY JSON FILTER [args...]
 if want bench; then
   echo "bench: deferred pass on the GPU"
   FOGCL_DEVICE=gpu bench fogcl_bench fog-gpu.json \
-    'BM_DeviceCopy|BM_OpenCLDevice/w:(1920|3840)/h:(1080|2160)/.*/nt:2|BM_OpenCLHostCall/w:(1920|3840)|BM_DispatchOverhead|BM_FirstDispatch|BM_ProgramBuild' \
+    'BM_DeviceCopy|BM_OpenCLDevice/w:(1920|3840)/h:(1080|2160)/.*/nt:2|BM_OpenCLHostCall/w:(1920|3840)|BM_PinnedTransfer|BM_DispatchOverhead|BM_FirstDispatch|BM_ProgramBuild' \
     --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
   echo "bench: volumetric pass on the GPU"
   FOGCL_DEVICE=gpu bench fogcl_volume_bench volume-gpu.json 'BM_VolumeDevice|BM_VolumeHostCall|BM_VolumeNothingVisible' \

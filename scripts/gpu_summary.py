@@ -184,6 +184,61 @@ for b in scalar:
 if scalar:
     p()
 
+# ---- host round trips against the bus ----------------------------------------------------------
+# Each convenience call's round trip (BM_OpenCLHostCall in fog-gpu.json, BM_VolumeHostCall in
+# volume-gpu.json) against BM_PinnedTransfer of the same bytes from the deferred run (color and
+# depth up, color down: the three buffers both passes' apply moves), matched by frame size and
+# storage. BM_VolumeHostCall names its width only (height = width * 9 / 16) and runs RGBA32F.
+# ratio = round trip ms / pinned transfer ms; above 1.5 a line starts with FAILED.
+transfers = {}
+for b in fog:
+    if b["base"].startswith("BM_PinnedTransfer/"):
+        a = args(b["base"])
+        transfers[(a["w"], a["h"], a["f16"], a["host"])] = b
+if transfers:
+    trips = []
+    modes = {"0": "linear", "1": "exp", "2": "exp2", "3": "height valley", "4": "height haze"}
+    for b in fog:
+        a = args(b["base"])
+        if b["base"].startswith("BM_OpenCLHostCall/") and a["w"] in ("1920", "3840"):
+            what = f'deferred {modes.get(a["mode"], a["mode"])}{" distance" if a["dist"] == "1" else ""}'
+            trips.append((what, a["w"], a["h"], a["f16"], b))
+    for b in vol:
+        a = args(b["base"])
+        if b["base"].startswith("BM_VolumeHostCall/"):
+            res = {"1": "full", "2": "half", "4": "quarter"}.get(a["divisor"], a["divisor"])
+            what = (f'volume {"physical" if a["integrator"] == "1" else "stylized"} {res}, '
+                    f'noise {"image" if a["noise_image"] == "1" else "buffer"}')
+            trips.append((what, a["width"], str(int(a["width"]) * 9 // 16), "0", b))
+    p("## Host round trip vs the pinned transfer of its bytes (median of 3)")
+    p()
+    p("Round trip: the convenience call, host images in and out. Pinned / pageable: BM_PinnedTransfer,")
+    p("color and depth written to device buffers then color read back, from CL_MEM_ALLOC_HOST_PTR memory")
+    p("mapped once / from ordinary memory, in the deferred pass's run. ratio = round trip / pinned (target <= 1.5).")
+    p()
+    p("| call | frame | color | round trip ms | pinned ms | pinned GB/s | pageable ms | pageable GB/s | ratio |")
+    p("|---|---|---|---:|---:|---:|---:|---:|---:|")
+    nan = float("nan")
+    verdicts = []
+    for what, w, h, f16, b in trips:
+        pinned, pageable = transfers.get((w, h, f16, "1")), transfers.get((w, h, f16, "0"))
+        fmt = "f16" if f16 == "1" else "f32"
+        ratio = ms(b) / ms(pinned) if pinned else nan
+        p(f'| {what} | {w}x{h} | {fmt} | {ms(b):.2f} | {ms(pinned) if pinned else nan:.2f} '
+          f'| {pinned["GBps"] if pinned else nan:.1f} | {ms(pageable) if pageable else nan:.2f} '
+          f'| {pageable["GBps"] if pageable else nan:.1f} | {ratio:.2f} |')
+        if ratio > 1.5:
+            verdicts.append(f"FAILED: round trip {what} {w}x{h} {fmt}: {ms(b):.2f} ms, {ratio:.2f}x the pinned "
+                            f"transfer of its bytes ({ms(pinned):.2f} ms; target <= 1.5x)")
+        elif not pinned:
+            verdicts.append(f"- round trip {what} {w}x{h} {fmt}: no pinned transfer of its frame in fog-gpu.json")
+    p()
+    met = len(trips) - len(verdicts)
+    p(f"- {met} of {len(trips)} round trips within 1.5x the pinned transfer of their bytes")
+    for v in verdicts:
+        p(v)
+    p()
+
 # ---- PoCL scaling ----------------------------------------------------------------------------
 pocl = sorted(glob.glob(os.path.join(results, "volume-pocl-*.json")), key=lambda s: int(re.findall(r"(\d+)\.json", s)[0]))
 if pocl:
