@@ -173,8 +173,10 @@ TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
   // --verbose names the variant.
   for (const char* part :
        {"volumes: 3 of 3 visible", "stylized integrator", "50 steps", "half resolution (32x18 target)",
-        "depth-aware upsampling", "buffer sampling", "march build options: ", "composite build options: "})
+        "depth-aware upsampling", "march build options: ", "composite build options: "})
     EXPECT_MSG_HAS(output, part);
+  // The default --noise-sampling auto, as the device resolves it.
+  EXPECT_MSG_HAS(output, std::string(to_string(pass.noise_sampling())) + " sampling");
   EXPECT_MSG_HAS(output, pass.last_march_options());
 
   // --noise-sampling image: the noise as an OpenCL 3D image with the sampler's filtering.

@@ -6,8 +6,11 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <string>
 #include <tuple>
+#include <vector>
 
+#include "volume/volume_params.h"
 #include "volume_support.h"
 
 namespace fogcl::test {
@@ -159,6 +162,86 @@ TEST_P(VolumeComposite, FollowsTheNanRules) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Storage, VolumeComposite, ::testing::Values(ColorFormat::rgba32f, ColorFormat::rgba16f));
+
+// NoiseSampling::automatic from the device's facts alone: no device needed.
+TEST(VolumeNoiseSampling, AutomaticResolvesFromTheDeviceFacts) {
+  const auto device = [](bool cpu, bool images, bool rgba8) {
+    NoiseSamplingDevice d;
+    d.cpu = cpu, d.images = images, d.rgba_unorm8_3d = rgba8;
+    return d;
+  };
+  const NoiseSampling a = NoiseSampling::automatic;
+  EXPECT_EQ(resolve_noise_sampling(a, device(true, true, true)), NoiseSampling::buffer) << "CPU (PoCL)";
+  EXPECT_EQ(resolve_noise_sampling(a, device(true, false, false)), NoiseSampling::buffer) << "CPU without images";
+  EXPECT_EQ(resolve_noise_sampling(a, device(false, true, true)), NoiseSampling::image) << "GPU with images";
+  EXPECT_EQ(resolve_noise_sampling(a, device(false, false, false)), NoiseSampling::buffer) << "GPU without images";
+  EXPECT_EQ(resolve_noise_sampling(a, device(false, true, false)), NoiseSampling::buffer) << "GPU without RGBA8 3D";
+  EXPECT_EQ(resolve_noise_sampling(a, NoiseSamplingDevice{}), NoiseSampling::buffer) << "the default facts";
+  for (const NoiseSampling explicit_choice : {NoiseSampling::buffer, NoiseSampling::image})
+    for (const bool cpu : {true, false}) {
+      EXPECT_EQ(resolve_noise_sampling(explicit_choice, device(cpu, true, true)), explicit_choice);
+    }
+  EXPECT_EQ(VolumeSettings{}.noise_sampling, a);
+  EXPECT_STREQ(to_string(a), "auto");
+  // The host paths pack automatic as the buffer: a variant never holds automatic.
+  const VolumeTestScene t = volume_test_scene(16, 9);
+  EXPECT_EQ(detail::pack_volume_frame(16, 9, t.frame.params, t.scene, VolumeSettings{}, ColorFormat::rgba32f, nullptr,
+                                      0, 0, INFINITY)
+                .variant.noise_sampling,
+            NoiseSampling::buffer);
+}
+
+// The default (automatic) on the tests' device: the pass reads the device's facts right (CPU
+// devices keep the buffer, bit for bit), the build options are the resolved sampling's, and the
+// output is the explicit choice's bit for bit and within that sampling's budget of the scalar
+// double march: 2e-4 for the buffer (exact trilinear), 2e-2 for the image (the texture unit's
+// filter weights; docs/accuracy.md#noise-sampling-on-gpus).
+TEST(VolumeNoiseSampling, AutomaticIsTheDevicesChoiceWithinItsBudget) {
+  FOGCL_REQUIRE_DEVICE();
+  const cl::Device device = wrap(runtime()->device());
+  NoiseSamplingDevice facts;
+  facts.cpu = (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+  facts.images = device.getInfo<CL_DEVICE_IMAGE_SUPPORT>() == CL_TRUE;
+  std::vector<cl::ImageFormat> formats;
+  if (facts.images)
+    wrap(runtime()->context()).getSupportedImageFormats(CL_MEM_READ_ONLY, CL_MEM_OBJECT_IMAGE3D, &formats);
+  for (const cl::ImageFormat& f : formats)
+    facts.rgba_unorm8_3d |= f.image_channel_order == CL_RGBA && f.image_channel_data_type == CL_UNORM_INT8;
+  VolumePass& pass = volume_pass();
+  const NoiseSampling chosen = pass.noise_sampling();
+  std::printf("  device %s: cpu %d, images %d, RGBA8 3D %d -> noise sampling %s\n", runtime()->description().c_str(),
+              int(facts.cpu), int(facts.images), int(facts.rgba_unorm8_3d), to_string(chosen));
+  EXPECT_EQ(chosen, resolve_noise_sampling(NoiseSampling::automatic, facts));
+  if (facts.cpu) {
+    EXPECT_EQ(chosen, NoiseSampling::buffer) << "CPU devices keep the buffer";
+  }
+  EXPECT_EQ(pass.noise_sampling(NoiseSampling::buffer), NoiseSampling::buffer);
+  EXPECT_EQ(pass.noise_sampling(NoiseSampling::image), NoiseSampling::image);
+  const double budget = chosen == NoiseSampling::image ? 2e-2 : 2e-4;
+  for (const VolumeIntegrator integrator : {VolumeIntegrator::stylized, VolumeIntegrator::physical}) {
+    const VolumeTestScene t = volume_test_scene(160, 90);
+    VolumeSettings settings;
+    settings.integrator = integrator;
+    settings.steps = 64;
+    ColorImage automatic, explicit_out;
+    pass.apply(t.frame.color, t.frame.depth, automatic, t.frame.params, t.scene, settings);
+    const std::string options = pass.last_march_options();
+    EXPECT_EQ(options.find("-D VOL_NOISE_IMAGE") != std::string::npos, chosen == NoiseSampling::image) << options;
+    settings.noise_sampling = chosen;
+    pass.apply(t.frame.color, t.frame.depth, explicit_out, t.frame.params, t.scene, settings);
+    EXPECT_EQ(pass.last_march_options(), options);
+    EXPECT_EQ(std::memcmp(automatic.data(), explicit_out.data(), automatic.size_bytes()), 0)
+        << "automatic differs from " << to_string(chosen);
+    const VolumeResult<double> ref =
+        volumes_scalar<double>(t.frame.color, t.frame.depth, t.frame.params, t.scene, settings);
+    const VolumeErrorStats s = compare_volumes(automatic, ref, budget);
+    std::printf("  %s, noise auto = %s, budget %.0e: %s\n", to_string(integrator), to_string(chosen), budget,
+                describe(s).c_str());
+    EXPECT_GT(s.fogged, s.pixels / 10);
+    EXPECT_EQ(s.nonfinite, 0u);
+    EXPECT_LE(s.max_abs, budget) << describe(s);
+  }
+}
 
 }  // namespace
 }  // namespace fogcl::test

@@ -161,6 +161,8 @@ TEST(VolumeReportOptionsCheck, BadOptionsNameTheValueAndTheRule) {
       {[](VolumeReportOptions& o) { o.divisors = {3}; }, "divisor must be 1, 2 or 4 (got 3)"},
       {[](VolumeReportOptions& o) { o.scenes = {"fog"}; }, "scene 'fog' is not one of"},
       {[](VolumeReportOptions& o) { o.width = 0; }, "frame size must be >= 1x1 (got 0x90)"},
+      {[](VolumeReportOptions& o) { o.noise = {NoiseSampling::automatic}; },
+       "noise sampling must be buffer or image (got auto)"},
   };
   for (const auto& c : cases) {
     VolumeReportOptions o;

@@ -410,7 +410,8 @@ const std::map<std::string, VolumeIntegrator> kIntegrators{{"stylized", VolumeIn
 const std::map<std::string, int> kResolutions{{"full", 1}, {"half", 2}, {"quarter", 4}};
 const std::map<std::string, VolumeUpsampling> kUpsamplings{{"depth-aware", VolumeUpsampling::depth_aware},
                                                            {"bilinear", VolumeUpsampling::bilinear}};
-const std::map<std::string, NoiseSampling> kSamplings{{"buffer", NoiseSampling::buffer},
+const std::map<std::string, NoiseSampling> kSamplings{{"auto", NoiseSampling::automatic},
+                                                      {"buffer", NoiseSampling::buffer},
                                                       {"image", NoiseSampling::image}};
 
 // The flags that mean nothing without --volumes.
@@ -488,7 +489,8 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
       ->capture_default_str()
       ->group(group);
   app.add_option("--noise-sampling", o.noise_sampling,
-                 "buffer (trilinear in the kernel) or image (OpenCL 3D image, hardware filtering on GPUs)")
+                 "auto (image on GPUs and accelerators with 3D images, else buffer), buffer (trilinear in the "
+                 "kernel) or image (OpenCL 3D image, hardware filtering on GPUs)")
       ->transform(CLI::IsMember(kSamplings, CLI::ignore_case))
       ->capture_default_str()
       ->group(group);
@@ -736,7 +738,8 @@ void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImag
                double(p.eye.x), double(p.eye.y), double(p.eye.z), double(p.forward.x), double(p.forward.y),
                double(p.forward.z), double(p.up.x), double(p.up.y), double(p.up.z), pose_from_.c_str());
   std::fprintf(stderr, "  noise: %d^3 texels, seed %u, %s sampling; shadow map: %s\n", settings_.noise_size,
-               unsigned(settings_.noise_seed), to_string(settings_.noise_sampling),
+               unsigned(settings_.noise_seed),
+               pass_ ? to_string(pass_->noise_sampling(settings_.noise_sampling)) : "trilinear (scalar)",
                shadow_ ? (std::to_string(shadow_->depth.width()) + "x" + std::to_string(shadow_->depth.height()) +
                           (shadow_->params.reversed_z ? ", reversed Z" : ", conventional Z"))
                              .c_str()

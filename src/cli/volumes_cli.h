@@ -30,7 +30,7 @@ struct VolumeCliOptions {
   double time = 0.0;    // --time [s]
   long long frame = 0;  // --frame: jitter seed
   double fps = 24.0;    // sequences: default time = frame number / fps
-  std::string integrator = "stylized", resolution = "half", upsample = "depth-aware", noise_sampling = "buffer";
+  std::string integrator = "stylized", resolution = "half", upsample = "depth-aware", noise_sampling = "auto";
   long long steps = 50, noise_size = 64, noise_seed = 1;
   std::string shadow_map_path, light_view_proj;
   bool shadow_reversed_z = false;

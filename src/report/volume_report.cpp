@@ -172,6 +172,9 @@ void validate(const VolumeReportOptions& o) {
   for (const std::string& s : o.scenes)
     if (std::find(names.begin(), names.end(), s) == names.end())
       throw Error("volume report scene '" + s + "' is not one of demo, dense, thin, inside");
+  for (NoiseSampling n : o.noise)  // rows name what ran: the device's choice is one of these two
+    if (n != NoiseSampling::buffer && n != NoiseSampling::image)
+      throw Error(std::string("volume report noise sampling must be buffer or image (got ") + to_string(n) + ")");
   if (o.steps.empty() || o.divisors.empty() || o.integrators.empty() || o.storages.empty() || o.noise.empty())
     throw Error("volume report needs at least one step count, resolution, integrator, storage and noise sampling");
 }

@@ -139,7 +139,19 @@ const char* to_string(VolumeIntegrator i) {
 }
 const char* to_string(VolumeUpsampling u) { return u == VolumeUpsampling::depth_aware ? "depth-aware" : "bilinear"; }
 const char* resolution_name(int divisor) { return divisor == 1 ? "full" : divisor == 2 ? "half" : "quarter"; }
-const char* to_string(NoiseSampling s) { return s == NoiseSampling::buffer ? "buffer" : "image"; }
+const char* to_string(NoiseSampling s) {
+  switch (s) {
+    case NoiseSampling::buffer: return "buffer";
+    case NoiseSampling::image: return "image";
+    case NoiseSampling::automatic: return "auto";
+  }
+  return "unknown";
+}
+
+NoiseSampling resolve_noise_sampling(NoiseSampling requested, const NoiseSamplingDevice& device) {
+  if (requested != NoiseSampling::automatic) return requested;
+  return !device.cpu && device.images && device.rgba_unorm8_3d ? NoiseSampling::image : NoiseSampling::buffer;
+}
 
 namespace {
 // The camera's rotation, view -> world (docs/volumetric.md §World and rays): columns right, up', forward.
@@ -248,7 +260,9 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   v.projection = camera.projection;
   v.reversed_z = camera.reversed_z;
   v.depth_kind = camera.depth_kind;
-  v.noise_sampling = settings.noise_sampling;
+  // The passes resolve automatic for their device before packing (VolumePass); the host paths
+  // (the scalar march, the OpenMP peer) filter like the buffer, which is what automatic is there.
+  v.noise_sampling = resolve_noise_sampling(settings.noise_sampling, NoiseSamplingDevice{});
   v.scale = s;
   v.depth_aware = settings.upsampling == VolumeUpsampling::depth_aware;
   v.storage = storage;

@@ -42,6 +42,8 @@ struct PackedVolumeFrame {
 };
 
 // Validates everything and packs the frame (culling with max_eye_depth). Throws fogcl::Error.
+// NoiseSampling::automatic packs as buffer (the host paths' filtering): a pass resolves it for its
+// device first (resolve_noise_sampling), so a variant never holds automatic.
 PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& camera, const VolumeScene& scene,
                                     const VolumeSettings& settings, ColorFormat storage,
                                     const ShadowMapParams* shadow, int shadow_width, int shadow_height,

@@ -36,6 +36,7 @@ struct VolumePass::Impl {
   cl::CommandQueue queue;  // convenience queue
   DeviceTraits traits;
   bool images = false;     // the device supports images
+  NoiseSamplingDevice noise_device;  // what NoiseSampling::automatic resolves from
   struct KernelEntry {
     cl::Kernel kernel;
     detail::WorkGroupShape shape;  // its launches' local size (runtime/work_groups.h)
@@ -78,6 +79,13 @@ struct VolumePass::Impl {
   }
   const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
                                     std::vector<cl::Event>& waits);
+  // `settings` with its noise sampling resolved for this device: what the variant, its build
+  // options and the noise upload are chosen from.
+  VolumeSettings resolved(const VolumeSettings& settings) const {
+    VolumeSettings r = settings;
+    r.noise_sampling = resolve_noise_sampling(settings.noise_sampling, noise_device);
+    return r;
+  }
 };
 
 VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs)
@@ -93,6 +101,16 @@ VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<
   m.programs = std::move(programs);
   m.traits = device_traits(device);
   m.images = with_cl_errors([&] { return m.device.getInfo<CL_DEVICE_IMAGE_SUPPORT>() == CL_TRUE; });
+  m.noise_device.cpu = m.traits.cpu;
+  m.noise_device.images = m.images;
+  if (m.images)  // the format noise_on_device creates its image with
+    m.noise_device.rgba_unorm8_3d = with_cl_errors([&] {
+      std::vector<cl::ImageFormat> formats;
+      m.context.getSupportedImageFormats(CL_MEM_READ_ONLY, CL_MEM_OBJECT_IMAGE3D, &formats);
+      for (const cl::ImageFormat& f : formats)
+        if (f.image_channel_order == CL_RGBA && f.image_channel_data_type == CL_UNORM_INT8) return true;
+      return false;
+    });
 }
 
 VolumePass::VolumePass(const Runtime& runtime, std::shared_ptr<ProgramCache> programs)
@@ -109,6 +127,9 @@ const ProgramCache& VolumePass::programs() const { return *impl_->programs; }
 const std::shared_ptr<ProgramCache>& VolumePass::program_cache() const { return impl_->programs; }
 const std::string& VolumePass::last_march_options() const { return impl_->last_march_options; }
 const std::string& VolumePass::last_composite_options() const { return impl_->last_composite_options; }
+NoiseSampling VolumePass::noise_sampling(NoiseSampling requested) const {
+  return resolve_noise_sampling(requested, impl_->noise_device);
+}
 
 const cl::Memory& VolumePass::Impl::noise_on_device(const cl::CommandQueue& q, const VolumeSettings& settings,
                                                     std::vector<cl::Event>& waits) {
@@ -146,9 +167,10 @@ const cl::Memory& VolumePass::Impl::noise_on_device(const cl::CommandQueue& q, c
   return it->second.first;
 }
 
-void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
+void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& requested,
                          ColorFormat storage, const ShadowMapParams* shadow) {
   Impl& m = *impl_;
+  const VolumeSettings settings = m.resolved(requested);
   if (settings.noise_sampling == NoiseSampling::image && !m.images)
     throw Error("noise sampling 'image' needs a device with image support; " + device_name(m.device()) +
                 " has none (use 'buffer')");
@@ -162,9 +184,10 @@ void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, c
 }
 
 cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
-                             const VolumeScene& scene, const VolumeSettings& settings, const ShadowMapBuffer* shadow,
+                             const VolumeScene& scene, const VolumeSettings& requested, const ShadowMapBuffer* shadow,
                              const std::vector<cl_event>& wait_list, float max_eye) {
   Impl& m = *impl_;
+  const VolumeSettings settings = m.resolved(requested);
   const detail::PackedVolumeFrame f =
       detail::pack_volume_frame(fb.width, fb.height, camera, scene, settings, fb.format,
                                 shadow ? &shadow->params : nullptr, shadow ? shadow->width : 0,

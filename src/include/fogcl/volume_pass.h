@@ -91,6 +91,9 @@ class VolumePass {
   // The march and composite build options of the most recent frame ("" when nothing ran).
   const std::string& last_march_options() const;
   const std::string& last_composite_options() const;
+  // The noise sampling this pass uses for `requested`: buffer and image as given, automatic (the
+  // VolumeSettings default) resolved for its device (resolve_noise_sampling).
+  NoiseSampling noise_sampling(NoiseSampling requested = NoiseSampling::automatic) const;
 
  private:
   struct Impl;

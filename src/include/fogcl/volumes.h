@@ -92,9 +92,24 @@ enum class VolumeUpsampling {
 };
 
 enum class NoiseSampling {
-  buffer,  // a buffer of unorm8 texels, trilinear filtering in the kernel (exact, any device)
-  image,   // an OpenCL 3D image with the sampler's linear filtering (hardware on GPUs)
+  buffer,     // a buffer of unorm8 texels, trilinear filtering in the kernel (exact, any device)
+  image,      // an OpenCL 3D image with the sampler's linear filtering (hardware on GPUs)
+  automatic,  // the device's: image where the texture unit filters, else buffer (resolve_noise_sampling)
 };
+
+// What NoiseSampling::automatic is resolved from: facts of the OpenCL device the pass runs on.
+struct NoiseSamplingDevice {
+  bool cpu = true;              // CL_DEVICE_TYPE_CPU (else a GPU or an accelerator)
+  bool images = false;          // CL_DEVICE_IMAGE_SUPPORT
+  bool rgba_unorm8_3d = false;  // CL_RGBA / CL_UNORM_INT8 among the context's read-only 3D image formats
+};
+
+// `requested` when it is buffer or image; for automatic, image on a device that is not a CPU, has
+// images and reads the noise's CL_RGBA / CL_UNORM_INT8 3D image (linear filtering applies to every
+// normalized format), else buffer. CPU devices keep the buffer: PoCL samples images in software,
+// 1.34x slower for the same error; a GPU's texture unit is 2.1-2.8x faster than the buffer on the
+// H100 (docs/gpu.md). The image's error budget: docs/accuracy.md#noise-sampling-on-gpus.
+NoiseSampling resolve_noise_sampling(NoiseSampling requested, const NoiseSamplingDevice& device);
 
 // Quality choices of the pass; each is a kernel build option (docs/volumetric.md §Variants and culling).
 struct VolumeSettings {
@@ -106,7 +121,7 @@ struct VolumeSettings {
   bool adaptive_steps = true;            // stylized: the seed's step refinement at fog onset
   int noise_size = 64;                   // noise texels per side: 32, 64 or 128
   std::uint32_t noise_seed = 1;
-  NoiseSampling noise_sampling = NoiseSampling::buffer;
+  NoiseSampling noise_sampling = NoiseSampling::automatic;  // resolved per device by the pass
 };
 
 // What changes from frame to frame.
