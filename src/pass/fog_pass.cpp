@@ -2,12 +2,14 @@
 
 #include <cstring>
 #include <map>
+#include <optional>
 
 #include "deferred_fog_cl.h"
 #include "fogcl/error.h"
 #include "pass/formulas.h"
 #include "runtime/clhpp.h"
 #include "runtime/frame_buffers.h"
+#include "runtime/host_staging.h"
 #include "settings/fog_coefficients.h"
 
 namespace fogcl {
@@ -38,6 +40,20 @@ struct FogPass::Impl {
   cl::Kernel* last_kernel = nullptr;
   PassStats stats;
   Variant last_variant;
+  HostTransfer transfer = HostTransfer::automatic;
+  std::unique_ptr<detail::HostStaging> staging;  // staged transfers: made on the first call
+
+  bool staged() const {
+    return transfer == HostTransfer::staged || (transfer == HostTransfer::automatic && !traits.cpu);
+  }
+  // apply()'s checks and sizing of `out`; the variant, or nullopt when no device work is needed
+  // (then `out` already holds the result).
+  std::optional<Variant> begin_apply(FogPass& pass, const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                                     const CameraParams& camera, const FogSettings& settings);
+  // The staged convenience call up to the download's enqueue; `done` is the kernel's event.
+  PendingFrame start_staged(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Variant& v,
+                            const CameraParams& camera, const FogSettings& settings, cl::Event& done);
+  void record_kernel_time(const cl::Event& done);
 
   cl::Kernel* find_kernel(const Variant& variant);
   // enqueue() after its checks: the variant `v` of (settings, camera, fb.format), a queue of the
@@ -185,40 +201,138 @@ cl_event FogPass::Impl::dispatch(const cl::CommandQueue& queue, const FrameBuffe
   return share(done);
 }
 
-void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
-                    const CameraParams& camera, const FogSettings& settings) {
-  Impl& m = *impl_;
+const char* to_string(HostTransfer transfer) {
+  switch (transfer) {
+    case HostTransfer::automatic: return "automatic";
+    case HostTransfer::direct: return "direct";
+    case HostTransfer::staged: return "staged";
+  }
+  return "?";
+}
+
+struct PendingFrame::Impl {
+  detail::HostStaging* staging = nullptr;
+  detail::StagedFrame frame;
+  ColorImage* out = nullptr;
+};
+
+PendingFrame::PendingFrame() = default;
+PendingFrame::~PendingFrame() {
+  try {
+    wait();
+  } catch (...) {
+  }
+}
+PendingFrame::PendingFrame(PendingFrame&&) noexcept = default;
+PendingFrame& PendingFrame::operator=(PendingFrame&& other) noexcept {
+  if (this != &other) {
+    try {
+      wait();
+    } catch (...) {
+    }
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
+
+void PendingFrame::wait() {
+  if (impl_ == nullptr) return;
+  const std::unique_ptr<Impl> m = std::move(impl_);  // once, also when it throws
+  with_cl_errors([&] { m->staging->finish(m->frame, *m->out); });
+}
+
+bool PendingFrame::done() const { return impl_ == nullptr; }
+
+void FogPass::set_host_transfer(HostTransfer transfer) { impl_->transfer = transfer; }
+HostTransfer FogPass::host_transfer() const {
+  return impl_->staged() ? HostTransfer::staged : HostTransfer::direct;
+}
+
+std::optional<Variant> FogPass::Impl::begin_apply(FogPass& pass, const ColorImage& in, const DepthImage& depth,
+                                                  ColorImage& out, const CameraParams& camera,
+                                                  const FogSettings& settings) {
   validate_frame(in, depth);
   validate(camera);
   const Variant v = select_variant(settings, camera, in.format());
   const bool in_place = &out == &in;
   if (!in_place && (out.width() != in.width() || out.height() != in.height() || out.format() != in.format()))
     out = ColorImage(in.width(), in.height(), in.format());
-  m.stats.last_kernel_ms = 0;
+  stats.last_kernel_ms = 0;
   if (!v.needs_pass()) {  // no device work at all
-    m.last_variant = v;
+    last_variant = v;
     if (!in_place) std::memcpy(out.data(), in.data(), in.size_bytes());
-    return;
+    return std::nullopt;
   }
-  prepare(v);  // apply blocks anyway: the one place that builds on demand
+  pass.prepare(v);  // the convenience calls block anyway: the one place that builds on demand
+  if (queue() == nullptr) queue = cl::CommandQueue(context, device, CL_QUEUE_PROFILING_ENABLE);
+  return v;
+}
+
+PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                                         const Variant& v, const CameraParams& camera, const FogSettings& settings,
+                                         cl::Event& done) {
+  if (staging == nullptr) staging = std::make_unique<detail::HostStaging>(context, device);
+  // A throw before the download is queued drops `frame`, which waits for what was enqueued.
+  detail::StagedFrame frame = staging->upload(in, depth);
+  done = adopt(dispatch(queue, frame.raw(), v, camera, settings, {frame.uploaded()()}));
+  queue.flush();
+  staging->download(frame, done);
+  ++stats.copied_frames;
+  PendingFrame pending;
+  pending.impl_ = std::make_unique<PendingFrame::Impl>();
+  pending.impl_->staging = staging.get();
+  pending.impl_->out = &out;
+  pending.impl_->frame = std::move(frame);
+  return pending;
+}
+
+// `done` has completed: its timestamps are final. A caller's queue (Runtime from handles) may
+// have no profiling: then there are none, and the figure stays 0.
+void FogPass::Impl::record_kernel_time(const cl::Event& done) {
+  cl_ulong start = 0, end = 0;
+  if (clGetEventProfilingInfo(done(), CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr) == CL_SUCCESS &&
+      clGetEventProfilingInfo(done(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr) == CL_SUCCESS)
+    stats.last_kernel_ms = double(end - start) * 1e-6;
+}
+
+void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                    const CameraParams& camera, const FogSettings& settings) {
+  Impl& m = *impl_;
+  const std::optional<Variant> v = m.begin_apply(*this, in, depth, out, camera, settings);
+  if (!v) return;
   with_cl_errors([&] {
-    if (m.queue() == nullptr) m.queue = cl::CommandQueue(m.context, m.device, CL_QUEUE_PROFILING_ENABLE);
+    cl::Event done;
+    if (m.staged()) {
+      m.start_staged(in, depth, out, *v, camera, settings, done).wait();
+      m.record_kernel_time(done);
+      return;
+    }
     // CPU devices read and write the host images where they are (page-aligned storage);
     // other devices get copies.
     const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
     // Input, camera and settings were checked above, the buffers are the frame's and the queue
     // the pass's: no integration-API checks (their getInfo calls were 5-14 us a call).
-    const cl::Event done = adopt(m.dispatch(m.queue, frame.raw, v, camera, settings, {}));
+    done = adopt(m.dispatch(m.queue, frame.raw, *v, camera, settings, {}));
     if (detail::read_back(m.queue, m.traits.cpu, frame, done, out))
       ++m.stats.zero_copy_frames;
     else
       ++m.stats.copied_frames;
-    // `done` has completed (read_back waited for it): its timestamps are final. A caller's queue
-    // (Runtime from handles) may have no profiling: then there are none, and the figure stays 0.
-    cl_ulong start = 0, end = 0;
-    if (clGetEventProfilingInfo(done(), CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr) == CL_SUCCESS &&
-        clGetEventProfilingInfo(done(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr) == CL_SUCCESS)
-      m.stats.last_kernel_ms = double(end - start) * 1e-6;
+    m.record_kernel_time(done);  // read_back waited for it
+  });
+}
+
+PendingFrame FogPass::apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                                  const CameraParams& camera, const FogSettings& settings) {
+  Impl& m = *impl_;
+  if (!m.staged()) {
+    apply(in, depth, out, camera, settings);
+    return PendingFrame();
+  }
+  const std::optional<Variant> v = m.begin_apply(*this, in, depth, out, camera, settings);
+  if (!v) return PendingFrame();
+  return with_cl_errors([&] {
+    cl::Event done;
+    return m.start_staged(in, depth, out, *v, camera, settings, done);
   });
 }
 

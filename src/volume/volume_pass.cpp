@@ -7,6 +7,7 @@
 #include "fogcl/error.h"
 #include "runtime/clhpp.h"
 #include "runtime/frame_buffers.h"
+#include "runtime/host_staging.h"
 #include "runtime/work_groups.h"
 #include "volume/volume_params.h"
 #include "volume_composite_cl.h"
@@ -46,6 +47,11 @@ struct VolumePass::Impl {
   std::map<std::tuple<int, unsigned, int>, std::pair<cl::Memory, cl::Event>> noise;
   VolumePassStats stats;
   std::string last_march_options, last_composite_options;
+  HostTransfer transfer = HostTransfer::automatic;
+  std::unique_ptr<detail::HostStaging> staging;  // staged transfers: made on the first call
+  bool staged() const {
+    return transfer == HostTransfer::staged || (transfer == HostTransfer::automatic && !traits.cpu);
+  }
 
   // The kernel of a built program, or nullptr (never builds; creates the kernel object when
   // another pass sharing the cache built the program). private_bytes: the host's bound of a work-item's
@@ -275,6 +281,11 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
   });
 }
 
+void VolumePass::set_host_transfer(HostTransfer transfer) { impl_->transfer = transfer; }
+HostTransfer VolumePass::host_transfer() const {
+  return impl_->staged() ? HostTransfer::staged : HostTransfer::direct;
+}
+
 void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
                        const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
   Impl& m = *impl_;
@@ -298,7 +309,6 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
   prepare(camera, scene, settings, in.format(), shadow ? &shadow->params : nullptr);  // apply blocks anyway
   with_cl_errors([&] {
     if (m.queue() == nullptr) m.queue = cl::CommandQueue(m.context, m.device, CL_QUEUE_PROFILING_ENABLE);
-    const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
     ShadowMapBuffer sm;
     cl::Buffer shadow_buffer;
     if (shadow) {
@@ -309,6 +319,17 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
                                  const_cast<float*>(shadow->depth.data()));
       sm.depth = shadow_buffer();
     }
+    if (m.staged()) {  // pinned staging (runtime/host_staging.h): the GPU default
+      if (m.staging == nullptr) m.staging = std::make_unique<detail::HostStaging>(m.context, m.device);
+      detail::StagedFrame staged = m.staging->upload(in, depth);
+      const cl::Event done = adopt(enqueue(m.queue(), staged.raw(), camera, scene, settings, shadow ? &sm : nullptr,
+                                           {staged.uploaded()()}, max_eye));
+      m.queue.flush();
+      m.staging->download(staged, done);
+      m.staging->finish(staged, out);
+      return;
+    }
+    const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
     const cl::Event done = adopt(enqueue(m.queue(), frame.raw, camera, scene, settings, shadow ? &sm : nullptr, {}, max_eye));
     detail::read_back(m.queue, m.traits.cpu, frame, done, out);
   });

@@ -46,6 +46,40 @@ struct PassStats {
   double last_kernel_ms = 0;
 };
 
+// How the convenience calls (apply, apply_async) move host images to the device and back.
+enum class HostTransfer {
+  automatic,  // direct on CPU devices, staged on the others (GPUs)
+  // Buffers made from the host images each call: on a CPU device the kernel reads and writes the
+  // images' own memory (CL_MEM_USE_HOST_PTR, nothing copied); elsewhere the driver copies them
+  // from pageable memory (~4x slower than staged on an H100: docs/gpu.md).
+  direct,
+  // Device buffers and pinned host staging kept per frame size and reused; the images are
+  // copied to and from the staging memory in bands that overlap the bus transfers. The GPU
+  // default; on a CPU device it runs the same code (tests check it gives the same bytes).
+  staged,
+};
+const char* to_string(HostTransfer transfer);
+
+// A convenience call in flight (FogPass::apply_async): wait() blocks until its `out` holds the
+// result. Its pass must outlive it. The destructor waits too (and swallows errors: call wait()).
+class PendingFrame {
+ public:
+  PendingFrame();
+  ~PendingFrame();
+  PendingFrame(PendingFrame&&) noexcept;
+  PendingFrame& operator=(PendingFrame&&) noexcept;
+  // Blocks until `out` holds the result; a second call returns at once. Throws fogcl::ClError
+  // when a command failed.
+  void wait();
+  // Whether wait() would return at once.
+  bool done() const;
+
+ private:
+  friend class FogPass;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 // Threads: a FogPass is not thread-safe (its kernels carry arguments between setArg and the
 // enqueue): use one per thread, or lock around it. Passes on any threads may share one
 // ProgramCache, which is thread-safe. Handles passed in are borrowed for the call, except the
@@ -90,6 +124,18 @@ class FogPass {
   // the kernel (CL_MEM_USE_HOST_PTR), nothing is copied.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
              const CameraParams& camera, const FogSettings& settings);
+  // apply() that returns once `in` and `depth` are no longer needed, before `out` holds the
+  // result (staged transfers: the upload, kernel and download are queued; the next call's upload
+  // overlaps this one's download). `out` is sized here and must stay alive and untouched until
+  // the returned frame's wait(), which may run on another thread. Up to three frames in flight;
+  // a fourth call waits for the oldest's wait(). With direct transfers it is apply() and returns
+  // a finished frame.
+  PendingFrame apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                           const CameraParams& camera, const FogSettings& settings);
+
+  // The convenience calls' transfers (default automatic); the choice in effect for this device.
+  void set_host_transfer(HostTransfer transfer);
+  HostTransfer host_transfer() const;
 
   // The build options this pass uses for `variant` on its device.
   std::string build_options_for(const Variant& variant) const;

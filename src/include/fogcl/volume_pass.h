@@ -84,6 +84,10 @@ class VolumePass {
   // depth image's range: nothing visible touches no device.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
              const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow = nullptr);
+  // The convenience call's transfers (FogPass's HostTransfer; default automatic: direct on CPU
+  // devices, pinned staging elsewhere); the choice in effect for this device.
+  void set_host_transfer(HostTransfer transfer);
+  HostTransfer host_transfer() const;
 
   const VolumePassStats& stats() const;
   const ProgramCache& programs() const;

@@ -1,0 +1,284 @@
+#include "runtime/host_staging.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace fogcl::detail {
+
+// ---- CopyWorkers -------------------------------------------------------------------------------
+
+CopyWorkers::CopyWorkers(int threads) {
+  for (int i = 1; i < threads; ++i) workers_.emplace_back([this] { work(); });
+}
+
+CopyWorkers::~CopyWorkers() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  for (std::thread& t : workers_) t.join();
+}
+
+// Runs one task of the current batch (the lock is released around it); false when none is left.
+bool CopyWorkers::take_and_run(std::unique_lock<std::mutex>& lock) {
+  if (task_ == nullptr || next_ >= count_) return false;
+  const int i = next_++;
+  ++running_;
+  const std::function<void(int)>& task = *task_;
+  lock.unlock();
+  std::exception_ptr error;
+  try {
+    task(i);
+  } catch (...) {
+    error = std::current_exception();
+  }
+  lock.lock();
+  if (error && !error_) error_ = error;
+  if (--running_ == 0 && next_ >= count_) finished_.notify_all();
+  return true;
+}
+
+void CopyWorkers::work() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [&] { return stop_ || (task_ != nullptr && next_ < count_); });
+    if (stop_) return;
+    while (take_and_run(lock)) {
+    }
+  }
+}
+
+void CopyWorkers::run(int n, const std::function<void(int)>& task) {
+  if (n <= 0) return;
+  if (workers_.empty() || n == 1) {
+    for (int i = 0; i < n; ++i) task(i);
+    return;
+  }
+  std::lock_guard<std::mutex> batch(batch_);
+  std::unique_lock<std::mutex> lock(mutex_);
+  task_ = &task;
+  next_ = 0;
+  count_ = n;
+  error_ = nullptr;
+  wake_.notify_all();
+  while (take_and_run(lock)) {
+  }
+  finished_.wait(lock, [&] { return running_ == 0 && next_ >= count_; });
+  task_ = nullptr;
+  if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+}
+
+// ---- slots -------------------------------------------------------------------------------------
+
+namespace {
+// Bands of ~4 MiB: large enough for the DMA engine's full rate, small enough that the first
+// transfer starts early and the copies spread over the threads.
+constexpr std::size_t kBandBytes = std::size_t(4) << 20;
+// A caller that never waits must not exhaust memory.
+constexpr long kMaxInFlight = 16;
+
+struct Band {
+  std::size_t offset, bytes;
+};
+std::vector<Band> bands(std::size_t total) {
+  const std::size_t n = std::max<std::size_t>(1, (total + kBandBytes - 1) / kBandBytes);
+  const std::size_t per = ((total + n - 1) / n + 4095) / 4096 * 4096;  // page multiples
+  std::vector<Band> out;
+  for (std::size_t at = 0; at < total; at += per) out.push_back({at, std::min(per, total - at)});
+  return out;
+}
+}  // namespace
+
+struct StagingSlot {
+  int width = 0, height = 0;
+  ColorFormat format = ColorFormat::rgba32f;
+  bool busy = false;
+  cl::Buffer color_in, depth, color_out;  // on the device
+  cl::Buffer pinned_in, pinned_out;       // host memory the driver has pinned, mapped for the slot's life
+  std::byte* in = nullptr;                // pinned_in: color, then depth
+  std::byte* out = nullptr;               // pinned_out: color
+  FrameBuffers raw;
+  cl::Event uploaded, after;              // after: the passes' last event (download())
+  std::vector<cl::Event> downloads;       // one per band of color_out
+  std::size_t color_bytes() const { return color_buffer_bytes(width, height, format); }
+  std::size_t depth_bytes() const { return depth_buffer_bytes(width, height); }
+};
+
+// ---- StagedFrame -------------------------------------------------------------------------------
+
+StagedFrame::StagedFrame(StagedFrame&& other) noexcept
+    : owner_(std::exchange(other.owner_, nullptr)), slot_(std::exchange(other.slot_, nullptr)) {}
+
+StagedFrame& StagedFrame::operator=(StagedFrame&& other) noexcept {
+  if (this != &other) {
+    release();
+    owner_ = std::exchange(other.owner_, nullptr);
+    slot_ = std::exchange(other.slot_, nullptr);
+  }
+  return *this;
+}
+
+StagedFrame::~StagedFrame() { release(); }
+
+const FrameBuffers& StagedFrame::raw() const { return slot_->raw; }
+const cl::Event& StagedFrame::uploaded() const { return slot_->uploaded; }
+
+// A frame given up before finish(): its commands may still use the slot's memory.
+void StagedFrame::release() {
+  if (slot_ == nullptr) return;
+  StagingSlot* s = std::exchange(slot_, nullptr);
+  try {
+    if (s->uploaded()) s->uploaded.wait();
+    if (s->after()) s->after.wait();
+    for (cl::Event& e : s->downloads) e.wait();
+  } catch (...) {
+    // A failed command is over, too: the slot can be reused.
+  }
+  owner_->give_back(s);
+}
+
+// ---- HostStaging -------------------------------------------------------------------------------
+
+namespace {
+// The bus moves ~55 GB/s, one core's memcpy ~10 (H100 host): up to 8 threads keep up with it.
+int copy_threads() { return int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u)); }
+}  // namespace
+
+HostStaging::HostStaging(const cl::Context& context, const cl::Device& device, int max_frames)
+    : context_(context),
+      device_(device),
+      upload_queue_(context, device),
+      download_queue_(context, device),
+      max_frames_(std::max(1, max_frames)),
+      up_workers_(copy_threads()),
+      down_workers_(copy_threads()) {}
+
+HostStaging::~HostStaging() {
+  try {
+    upload_queue_.finish();
+    download_queue_.finish();
+    for (auto& s : slots_) unmap(*s);
+  } catch (...) {
+  }
+}
+
+std::size_t HostStaging::slots() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return slots_.size();
+}
+
+void HostStaging::give_back(StagingSlot* slot) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  slot->busy = false;
+  slot->uploaded = cl::Event();
+  slot->after = cl::Event();
+  slot->downloads.clear();
+  // Frames beyond max_frames in flight got slots of their own: keep max_frames slots' memory.
+  if (int(slots_.size()) > max_frames_) {
+    const auto it = std::find_if(slots_.begin(), slots_.end(), [&](const auto& s) { return s.get() == slot; });
+    unmap(*slot);
+    slots_.erase(it);
+  }
+}
+
+void HostStaging::unmap(StagingSlot& s) {
+  upload_queue_.enqueueUnmapMemObject(s.pinned_in, s.in);
+  upload_queue_.enqueueUnmapMemObject(s.pinned_out, s.out);
+  upload_queue_.finish();
+}
+
+StagingSlot& HostStaging::take_slot(int width, int height, ColorFormat format) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  {
+    for (auto& s : slots_)
+      if (!s->busy && s->width == width && s->height == height && s->format == format) {
+        s->busy = true;
+        return *s;
+      }
+    const auto busy = std::count_if(slots_.begin(), slots_.end(), [](const auto& s) { return s->busy; });
+    if (busy >= kMaxInFlight)
+      throw Error("more than " + std::to_string(kMaxInFlight) +
+                  " staged frames in flight: wait() for earlier frames before starting more");
+    // A new size (or every slot busy): drop a free slot of another size first, keeping at most
+    // max_frames slots' memory.
+    if (int(slots_.size()) >= max_frames_) {
+      const auto idle = std::find_if(slots_.begin(), slots_.end(), [](const auto& s) { return !s->busy; });
+      if (idle != slots_.end()) {
+        unmap(**idle);
+        slots_.erase(idle);
+      }
+    }
+    auto s = std::make_unique<StagingSlot>();
+    s->width = width;
+    s->height = height;
+    s->format = format;
+    const std::size_t color = s->color_bytes(), depth = s->depth_bytes();
+    s->color_in = cl::Buffer(context_, CL_MEM_READ_WRITE, color);
+    s->depth = cl::Buffer(context_, CL_MEM_READ_ONLY, depth);
+    s->color_out = cl::Buffer(context_, CL_MEM_READ_WRITE, color);
+    s->pinned_in = cl::Buffer(context_, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR, color + depth);
+    s->pinned_out = cl::Buffer(context_, CL_MEM_WRITE_ONLY | CL_MEM_ALLOC_HOST_PTR, color);
+    s->in = static_cast<std::byte*>(upload_queue_.enqueueMapBuffer(s->pinned_in, CL_TRUE, CL_MAP_WRITE, 0, color + depth));
+    s->out = static_cast<std::byte*>(upload_queue_.enqueueMapBuffer(s->pinned_out, CL_TRUE, CL_MAP_READ, 0, color));
+    s->raw.width = width;
+    s->raw.height = height;
+    s->raw.format = format;
+    s->raw.color_in = s->color_in();
+    s->raw.depth = s->depth();
+    s->raw.color_out = s->color_out();
+    s->busy = true;
+    slots_.push_back(std::move(s));
+    return *slots_.back();
+  }
+}
+
+StagedFrame HostStaging::upload(const ColorImage& in, const DepthImage& depth) {
+  StagedFrame frame;
+  frame.owner_ = this;
+  frame.slot_ = &take_slot(in.width(), in.height(), in.format());
+  StagingSlot& s = *frame.slot_;
+  const std::size_t color = s.color_bytes();
+  const std::vector<Band> color_bands = bands(color), depth_bands = bands(s.depth_bytes());
+  const auto* color_src = static_cast<const std::byte*>(in.data());
+  const auto* depth_src = reinterpret_cast<const std::byte*>(depth.data());
+  // Each band's DMA is enqueued by the thread that filled it, as soon as it is filled.
+  up_workers_.run(int(color_bands.size() + depth_bands.size()), [&](int i) {
+    const bool is_color = std::size_t(i) < color_bands.size();
+    const Band b = is_color ? color_bands[i] : depth_bands[i - color_bands.size()];
+    std::byte* pinned = s.in + (is_color ? 0 : color) + b.offset;
+    std::memcpy(pinned, (is_color ? color_src : depth_src) + b.offset, b.bytes);
+    upload_queue_.enqueueWriteBuffer(is_color ? s.color_in : s.depth, CL_FALSE, b.offset, b.bytes, pinned);
+  });
+  upload_queue_.enqueueMarkerWithWaitList(nullptr, &s.uploaded);
+  upload_queue_.flush();
+  return frame;
+}
+
+void HostStaging::download(StagedFrame& frame, const cl::Event& after) {
+  StagingSlot& s = *frame.slot_;
+  s.after = after;
+  const std::vector<cl::Event> wait{after};
+  for (const Band& b : bands(s.color_bytes())) {
+    cl::Event e;
+    download_queue_.enqueueReadBuffer(s.color_out, CL_FALSE, b.offset, b.bytes, s.out + b.offset, &wait, &e);
+    s.downloads.push_back(e);
+  }
+  download_queue_.flush();
+}
+
+void HostStaging::finish(StagedFrame& frame, ColorImage& out) {
+  if (!frame) return;
+  StagingSlot& s = *frame.slot_;
+  if (s.downloads.empty()) throw Error("HostStaging::finish: the frame's download was never enqueued");
+  const std::vector<Band> color_bands = bands(s.color_bytes());
+  auto* dst = static_cast<std::byte*>(out.data());
+  // Band b is copied out as soon as its DMA is done, while later bands still cross the bus.
+  down_workers_.run(int(color_bands.size()), [&](int b) {
+    s.downloads[b].wait();
+    std::memcpy(dst + color_bands[b].offset, s.out + color_bands[b].offset, color_bands[b].bytes);
+  });
+  frame.release();
+}
+
+}  // namespace fogcl::detail

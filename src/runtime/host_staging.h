@@ -1,0 +1,115 @@
+// Host images to and from a device that is not the host's memory (a GPU): pinned staging at the
+// speed of the bus (docs/gpu.md, "Host round trip").
+//
+// A pageable clEnqueueWriteBuffer/ReadBuffer goes through the driver's own bounce buffers at a
+// quarter of the bus (H100, PCIe 5: 11-14 GB/s against 55 GB/s pinned). So each frame size gets
+// device buffers and pinned host memory (CL_MEM_ALLOC_HOST_PTR, mapped once: NVIDIA's pinned
+// allocation), kept and reused across calls. The caller's pixels are copied into the pinned memory
+// in bands by a few threads, each band's DMA enqueued as soon as its bytes are there, so the copy
+// and the transfer overlap; the download mirrors it. Up to `max_frames` frames may be in flight
+// (upload of one, kernels of the next, download of a third: the sequence pipeline's overlap).
+// CPU devices do not come here: the kernel reads the host images in place (frame_buffers.h).
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "fogcl/fog_pass.h"
+#include "fogcl/image.h"
+#include "runtime/clhpp.h"
+
+namespace fogcl::detail {
+
+// A few persistent threads for the staging copies: run(n, task) calls task(0..n-1) on them and
+// on the calling thread, and returns when all have run (the first exception is rethrown).
+class CopyWorkers {
+ public:
+  explicit CopyWorkers(int threads);
+  ~CopyWorkers();
+  CopyWorkers(const CopyWorkers&) = delete;
+  CopyWorkers& operator=(const CopyWorkers&) = delete;
+  int threads() const { return int(workers_.size()) + 1; }
+  // One batch at a time: a second caller waits for the first's batch to end.
+  void run(int n, const std::function<void(int)>& task);
+
+ private:
+  std::mutex batch_;
+  void work();
+  bool take_and_run(std::unique_lock<std::mutex>& lock);
+  std::vector<std::thread> workers_;
+  std::mutex mutex_;
+  std::condition_variable wake_, finished_;
+  const std::function<void(int)>* task_ = nullptr;
+  int next_ = 0, count_ = 0, running_ = 0;
+  std::exception_ptr error_;
+  bool stop_ = false;
+};
+
+class HostStaging;
+struct StagingSlot;
+
+// One frame's device buffers and pinned memory while it is in flight. `raw` names the device
+// buffers for the passes (color_out distinct from color_in); `uploaded` is the event the passes'
+// kernels wait for. Destroying it waits for its commands and frees the slot.
+class StagedFrame {
+ public:
+  StagedFrame() = default;
+  StagedFrame(StagedFrame&& other) noexcept;
+  StagedFrame& operator=(StagedFrame&& other) noexcept;
+  ~StagedFrame();
+  explicit operator bool() const { return slot_ != nullptr; }
+
+  const FrameBuffers& raw() const;
+  const cl::Event& uploaded() const;
+
+ private:
+  friend class HostStaging;
+  HostStaging* owner_ = nullptr;
+  StagingSlot* slot_ = nullptr;
+  void release();
+};
+
+class HostStaging {
+ public:
+  // max_frames >= 1: the frames in flight whose slots stay allocated (three: upload, kernels and
+  // download of consecutive frames). More may be in flight, up to 16 (then upload() throws).
+  HostStaging(const cl::Context& context, const cl::Device& device, int max_frames = 3);
+  ~HostStaging();
+  HostStaging(const HostStaging&) = delete;
+  HostStaging& operator=(const HostStaging&) = delete;
+
+  // Copies in and depth (same size) into a free slot's pinned memory and enqueues their upload;
+  // returns when the host images are no longer needed (the DMA may still run).
+  StagedFrame upload(const ColorImage& in, const DepthImage& depth);
+  // Enqueues the download of frame.raw().color_out after `after` (the passes' last event).
+  void download(StagedFrame& frame, const cl::Event& after);
+  // Waits for the download and copies it into `out` (the frame's size and format); then the
+  // slot is free for the next upload. Thread-safe against upload() of other frames.
+  void finish(StagedFrame& frame, ColorImage& out);
+
+  // Frames of each size whose buffers are kept (for tests and stats).
+  std::size_t slots() const;
+
+ private:
+  friend class StagedFrame;
+  void give_back(StagingSlot* slot);
+  void unmap(StagingSlot& slot);
+  StagingSlot& take_slot(int width, int height, ColorFormat format);
+
+  cl::Context context_;
+  cl::Device device_;
+  cl::CommandQueue upload_queue_, download_queue_;
+  int max_frames_;
+  // Uploads (the passes' thread) and downloads (finish(), possibly another thread) copy at once.
+  CopyWorkers up_workers_, down_workers_;
+  mutable std::mutex mutex_;
+  std::vector<std::unique_ptr<StagingSlot>> slots_;
+};
+
+}  // namespace fogcl::detail

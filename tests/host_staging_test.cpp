@@ -1,0 +1,154 @@
+// Staged host transfers (runtime/host_staging.h): the GPU default, run here on the suite's device
+// whatever it is. They must give the bytes of the direct path (on a CPU device: the kernel on the
+// images' own memory), for odd sizes, both storages, in place, with frames in flight and waited
+// for on another thread, and for the volumetric pass.
+#include <cstring>
+#include <future>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "fogcl/fog_pass.h"
+#include "fogcl/volume_pass.h"
+#include "test_support.h"
+#include "volume_support.h"
+
+namespace fogcl::test {
+namespace {
+
+FogSettings exp2_fog() {
+  FogSettings s;
+  s.mode = FogMode::exp2;
+  s.density = 0.02f;
+  s.color = {0.4f, 0.5f, 0.6f};
+  return s;
+}
+
+// Bytes that differ between two images of the same size and format (all of them if they do not match).
+std::size_t differing_bytes(const ColorImage& a, const ColorImage& b) {
+  if (a.size_bytes() != b.size_bytes() || a.format() != b.format()) return std::max(a.size_bytes(), b.size_bytes());
+  const auto* x = static_cast<const unsigned char*>(a.data());
+  const auto* y = static_cast<const unsigned char*>(b.data());
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < a.size_bytes(); ++i) n += x[i] != y[i];
+  return n;
+}
+
+struct Passes {
+  FogPass direct{*runtime()};
+  FogPass staged{*runtime()};
+  Passes() {
+    direct.set_host_transfer(HostTransfer::direct);
+    staged.set_host_transfer(HostTransfer::staged);
+  }
+};
+
+TEST(HostStaging, SameBytesAsDirectForEverySizeAndStorage) {
+  FOGCL_REQUIRE_DEVICE();
+  Passes p;
+  EXPECT_EQ(p.staged.host_transfer(), HostTransfer::staged);
+  EXPECT_EQ(p.direct.host_transfer(), HostTransfer::direct);
+  // 1x1, a width that is no multiple of 16, a frame of several 4 MiB bands with a short last one.
+  const int sizes[][2] = {{1, 1}, {17, 3}, {320, 180}, {1000, 1333}};
+  std::size_t worst = 0;
+  for (const auto& wh : sizes)
+    for (ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
+      const TestFrame f = make_test_frame(wh[0], wh[1], false, format, 11);
+      ColorImage direct, staged;
+      p.direct.apply(f.color, f.depth, direct, f.params, exp2_fog());
+      p.staged.apply(f.color, f.depth, staged, f.params, exp2_fog());
+      const std::size_t d = differing_bytes(direct, staged);
+      worst = std::max(worst, d);
+      EXPECT_EQ(d, 0u) << wh[0] << "x" << wh[1] << " " << to_string(format);
+      EXPECT_GT(differing_bytes(staged, f.color), 0u) << "the fog changed nothing: the check could not fail";
+    }
+  std::printf("staged vs direct: worst %zu differing bytes over 8 frames\n", worst);
+  EXPECT_EQ(p.staged.stats().copied_frames, 8u);
+}
+
+TEST(HostStaging, InPlaceAndFogOff) {
+  FOGCL_REQUIRE_DEVICE();
+  Passes p;
+  const TestFrame f = make_test_frame(64, 37, true, ColorFormat::rgba32f, 5);
+  ColorImage want;
+  p.direct.apply(f.color, f.depth, want, f.params, exp2_fog());
+  ColorImage frame = f.color;
+  p.staged.apply(frame, f.depth, frame, f.params, exp2_fog());
+  EXPECT_EQ(differing_bytes(frame, want), 0u);
+  FogSettings off = exp2_fog();
+  off.density = 0;  // no pass: the input, copied on the host
+  ColorImage out;
+  p.staged.apply(f.color, f.depth, out, f.params, off);
+  EXPECT_EQ(differing_bytes(out, f.color), 0u);
+}
+
+// Frames in flight: three started before any is waited for, waited for on another thread in
+// the sequence pipeline's way, with a size change in the middle; each gives its own frame's bytes.
+TEST(HostStaging, FramesInFlightWaitedForOnAnotherThread) {
+  FOGCL_REQUIRE_DEVICE();
+  Passes p;
+  std::vector<TestFrame> frames;
+  std::vector<ColorImage> want(6), got(6);
+  for (int i = 0; i < 6; ++i) {
+    frames.push_back(make_test_frame(i == 3 ? 200 : 160, 90, false, ColorFormat::rgba16f, 100 + i));
+    p.direct.apply(frames[i].color, frames[i].depth, want[i], frames[i].params, exp2_fog());
+  }
+  std::vector<PendingFrame> pending;
+  for (int i = 0; i < 3; ++i)
+    pending.push_back(p.staged.apply_async(frames[i].color, frames[i].depth, got[i], frames[i].params, exp2_fog()));
+  // The inputs are no longer needed once apply_async returns: overwrite them.
+  for (int i = 0; i < 3; ++i) std::memset(frames[i].color.data(), 0xff, frames[i].color.size_bytes());
+  auto waiter = std::async(std::launch::async, [&] {
+    for (int i = 0; i < 3; ++i) pending[i].wait();
+  });
+  waiter.get();
+  for (int i = 3; i < 6; ++i) {
+    PendingFrame f = p.staged.apply_async(frames[i].color, frames[i].depth, got[i], frames[i].params, exp2_fog());
+    EXPECT_FALSE(f.done());
+    f.wait();
+    EXPECT_TRUE(f.done());
+    f.wait();  // a second wait returns at once
+  }
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(differing_bytes(got[i], want[i]), 0u) << "frame " << i;
+}
+
+TEST(HostStaging, TooManyFramesInFlightIsAnErrorNotAHang) {
+  FOGCL_REQUIRE_DEVICE();
+  Passes p;
+  const TestFrame f = make_test_frame(8, 8, false, ColorFormat::rgba32f, 3);
+  std::vector<ColorImage> outs(17);
+  std::vector<PendingFrame> pending;
+  for (int i = 0; i < 16; ++i) pending.push_back(p.staged.apply_async(f.color, f.depth, outs[i], f.params, exp2_fog()));
+  try {
+    pending.push_back(p.staged.apply_async(f.color, f.depth, outs[16], f.params, exp2_fog()));
+    ADD_FAILURE() << "a 17th frame in flight was accepted";
+  } catch (const Error& e) {
+    std::printf("17th frame in flight: %s\n", e.what());
+    EXPECT_NE(std::string(e.what()).find("wait()"), std::string::npos);
+  }
+  for (PendingFrame& x : pending) x.wait();
+  // After the waits the slots are free again.
+  ColorImage out;
+  p.staged.apply_async(f.color, f.depth, out, f.params, exp2_fog()).wait();
+  EXPECT_EQ(differing_bytes(out, outs[0]), 0u);
+}
+
+TEST(HostStaging, VolumesSameBytesAsDirect) {
+  FOGCL_REQUIRE_DEVICE();
+  VolumePass direct(*runtime()), staged(*runtime());
+  direct.set_host_transfer(HostTransfer::direct);
+  staged.set_host_transfer(HostTransfer::staged);
+  for (ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
+    VolumeTestScene t = volume_test_scene(123, 71, format);
+    VolumeSettings settings;
+    settings.steps = 16;
+    ColorImage a, b;
+    direct.apply(t.frame.color, t.frame.depth, a, t.frame.params, t.scene, settings);
+    staged.apply(t.frame.color, t.frame.depth, b, t.frame.params, t.scene, settings);
+    EXPECT_EQ(differing_bytes(a, b), 0u) << to_string(format);
+    EXPECT_GT(differing_bytes(b, t.frame.color), 0u) << "no volume visible: the check could not fail";
+  }
+}
+
+}  // namespace
+}  // namespace fogcl::test
