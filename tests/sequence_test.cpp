@@ -316,6 +316,56 @@ TEST_F(Sequence, ThreadCountsAndThePipelineChangeNoByte) {
   }
 }
 
+// Staged transfers (the GPU default, --host-transfer staged here on the suite's device): frames
+// overlap (a frame's download is waited for by the writer while the next one uploads), through
+// a size change and a frame that fails to read; the files are those of direct transfers, byte
+// for byte, with and without the volumes.
+TEST_F(Sequence, StagedTransfersOverlapFramesAndWriteTheBytesOfDirectOnes) {
+  FOGCL_REQUIRE_DEVICE();
+  make_frames(6, 64, 36);
+  // Frame 4 at another size, frame 5 unreadable: a new slot size, then a frame without one.
+  {
+    DemoView view;
+    PerspectiveCamera camera;
+    camera.fov_y_deg = 60.0f;
+    const DemoFrame frame = render_demo_scene(80, 45, camera, view);
+    write_exr_rgba(path("in/" + frame_name("color", 4)), frame.color);
+    write_exr_depth(path("in/" + frame_name("depth", 4)), frame.depth);
+  }
+  std::ofstream(path("in/" + frame_name("color", 5)), std::ios::trunc) << "not an EXR file";
+  write_text(path("in/volumes.json"), R"({"volumes": [
+    {"center": [0.5, 1.5, -4], "radius": 5, "density": 0.6, "tiling": [0.2, 0.2, 0.2]},
+    {"center": [3, 1.5, 3], "radius": 3, "density": 1.0, "noise": false}]})");
+  // The demo view's pose (DemoView's eye, looking at its target): the volumes are in sight.
+  const DemoView view;
+  const glm::vec3 forward = view.target - view.eye;
+  char pose[200];
+  std::snprintf(pose, sizeof pose, " --eye %g,%g,%g --forward %g,%g,%g --up 0,1,0", double(view.eye.x),
+                double(view.eye.y), double(view.eye.z), double(forward.x), double(forward.y), double(forward.z));
+  for (const std::string& volumes : {std::string(), " --volumes " + path("in/volumes.json") + pose}) {
+    const std::string tag = volumes.empty() ? "" : "-volumes";
+    const std::string args = inputs() + volumes + " --keep-going --device cpu --host-transfer ";
+    const CliRun direct = run_cli(args + "direct --out " + path("out/direct" + tag + ".####.exr"));
+    const CliRun staged =
+        run_cli(args + "staged --verbose --out " + path("out/staged" + tag + ".####.exr"), "FOGCL_TIERING=off");
+    EXPECT_NE(staged.output.find("host transfers: staged"), std::string::npos) << staged.output;
+    EXPECT_EQ(direct.exit_code, 1) << direct.output;  // frame 5 failed, the others were written
+    EXPECT_EQ(staged.exit_code, 1) << staged.output;
+    EXPECT_NE(staged.output.find("1 of 6 frames failed"), std::string::npos) << staged.output;
+    for (int f : {1, 2, 3, 4, 6}) {
+      const std::vector<char> bytes = file_bytes(path("out/" + frame_name("direct" + tag, f)));
+      EXPECT_FALSE(bytes.empty()) << tag << " frame " << f;
+      EXPECT_EQ(bytes, file_bytes(path("out/" + frame_name("staged" + tag, f)))) << tag << " frame " << f;
+    }
+    EXPECT_FALSE(fs::exists(path("out/" + frame_name("staged" + tag, 5))));
+  }
+  // The volumes changed the frames: the comparison above covered their pass too.
+  EXPECT_NE(file_bytes(path("out/" + frame_name("staged", 1))), file_bytes(path("out/" + frame_name("staged-volumes", 1))));
+  const CliRun bad = run_cli(inputs() + " --host-transfer pinned --out " + path("out/bad.####.exr"));
+  EXPECT_EQ(bad.exit_code, 1) << bad.output;
+  EXPECT_NE(bad.output.find("--host-transfer: pinned not in {auto,direct,staged}"), std::string::npos) << bad.output;
+}
+
 // The pieces the CLI runs on its threads give the bits of one call (float and half storage,
 // distance-based: the rays depend on the row).
 TEST(ScalarRows, BandsGiveTheBitsOfOneCall) {

@@ -159,7 +159,10 @@ struct FrameJob {
   std::optional<CameraPose> pose;  // for the volumes, when it comes with the frame (cli/camera_cli.h)
   std::string pose_from;
   std::string height_pose_from;  // --mode height: where the pose came from (--verbose)
-  ColorImage out;      // the fogged frame
+  ColorImage out;      // the fogged frame: holds it once `pending` has been waited for
+  // The deferred pass in flight (staged transfers, a GPU): its download overlaps the next frame's
+  // upload and kernels; the writer waits for it.
+  PendingFrame pending;
 };
 
 // A fogged frame's inputs, kept for the next frame's read (ExrReadRequest::color_into).
@@ -264,7 +267,13 @@ struct Devices {
   explicit Devices(const ApplyOptions& o)
       : backend(o.device),
         volumes(VolumeStage::create(o.volumes, backend.runtime())),
-        scalar_bits(backend.runtime() != nullptr && device_is_pocl_cpu(backend.runtime()->device())) {}
+        scalar_bits(backend.runtime() != nullptr && device_is_pocl_cpu(backend.runtime()->device())) {
+    const HostTransfer transfer = o.host_transfer == "staged"   ? HostTransfer::staged
+                                  : o.host_transfer == "direct" ? HostTransfer::direct
+                                                                : HostTransfer::automatic;
+    if (backend.pass() != nullptr) backend.pass()->set_host_transfer(transfer);
+    if (volumes) volumes->set_host_transfer(transfer);
+  }
 };
 
 // Tiering: PoCL takes 0.2-0.4 s to open (the dynamic loader relocating LLVM and clang), the
@@ -343,6 +352,10 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
     const DepthKind kind = parse_depth_kind(o.depth_kind);
     const Variant variant = select_variant(settings, params, color.color.format());
     std::fprintf(stderr, "device: %s\n", backend.name().c_str());
+    if (FogPass* pass = backend.pass())
+      std::fprintf(stderr, "host transfers: %s\n", pass->host_transfer() == HostTransfer::staged
+                                                       ? "staged (pinned staging, frames overlapped)"
+                                                       : "direct (the device uses the images' memory)");
     std::fprintf(stderr, "camera: %s\n", job.camera_text.c_str());
     if (settings.mode == FogMode::height && params.pose)  // --mode height: the pose its rays come from
       std::fprintf(stderr, "height fog pose (fogcl's world): eye (%g, %g, %g), forward (%g, %g, %g), up (%g, %g, %g), from %s\n",
@@ -386,7 +399,7 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
   } else if (volumes != nullptr) {
     volumes->apply(job.color.color, job.depth, job.color.color, params, sequence_frame, print_setup);
   }
-  backend.apply(color.color, job.depth, job.out, params, settings);
+  job.pending = backend.apply_async(color.color, job.depth, job.out, params, settings);
 }
 
 // The fogged frame's input pixels are not needed any more: memory stays bounded.
@@ -399,6 +412,7 @@ InputFrames take_inputs(FrameJob& job) {
 
 // Writes a fogged frame (and its preview) (writer thread).
 void write_frame(const ApplyOptions& o, FrameJob& job) {
+  job.pending.wait();
   ExrWriteOptions w;
   w.half = o.pixel_type == "half";
   w.compression = o.compression.empty() ? -1 : parse_exr_compression(o.compression);

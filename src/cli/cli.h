@@ -23,6 +23,10 @@ class Backend {
   std::string name() const;  // "scalar" or the OpenCL device's description
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
              const CameraParams& camera, const FogSettings& settings);
+  // FogPass::apply_async on a device (the result is in `out` after wait()); apply() on the
+  // scalar path (a finished frame).
+  PendingFrame apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                           const CameraParams& camera, const FogSettings& settings);
   FogPass* pass() { return pass_.get(); }
   const Runtime* runtime() const { return runtime_.get(); }  // null for scalar
 
@@ -52,6 +56,7 @@ struct ApplyOptions {
   bool keep_going = false;         // sequences: continue past a bad frame
   std::string max_memory;          // --max-memory: "" = half of the machine's memory (cli/frame_memory.h)
   int threads = 0;                 // OpenEXR's (de)compression threads (and PoCL's); 0 = every core
+  std::string host_transfer = "auto";  // --host-transfer: auto | direct | staged (fogcl::HostTransfer)
   std::string pixel_type = "float";  // of the fogged R, G, B, A: float | half
   std::string compression;         // of the output's color part; "" = the input's
   bool reversed_z = false;

@@ -99,6 +99,13 @@ std::string Backend::name() const {
                       : "scalar C++ (row bands on OpenEXR's pool of " + std::to_string(threads) + " threads)";
 }
 
+PendingFrame Backend::apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                                  const CameraParams& camera, const FogSettings& settings) {
+  if (pass_) return pass_->apply_async(in, depth, out, camera, settings);
+  apply(in, depth, out, camera, settings);
+  return PendingFrame();
+}
+
 void Backend::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                     const CameraParams& camera, const FogSettings& settings) {
   if (pass_) {

@@ -127,6 +127,13 @@ int main(int argc, char** argv) {
                         "the volumetric steps, resolution, upsampling and noise sampling the same way "
                         "(fogcl report --volumetric's scenes); not with those flags");
   apply_cmd->add_option("--device", ap.device, kDeviceHelp);
+  apply_cmd->add_option("--host-transfer", ap.host_transfer,
+                        "How frames reach the device: auto (direct on a CPU device, staged on a GPU), direct "
+                        "(the device uses the images' memory; a GPU driver copies from pageable memory) or staged "
+                        "(pinned staging reused across frames; a sequence's uploads, kernels and downloads "
+                        "overlap)")
+      ->check(CLI::IsMember({"auto", "direct", "staged"}))
+      ->capture_default_str();
   apply_cmd->add_flag("--verbose", ap.verbose, "Print the device, the kernel variant chosen and why");
   fogcl::cli::add_volume_options(*apply_cmd, ap.volumes);
   fogcl::cli::add_camera_options(*apply_cmd, ap.camera);

@@ -90,6 +90,10 @@ class VolumeStage {
   void set_frame_pose(const std::optional<CameraPose>& pose, const std::string& from);
   const VolumeSettings& settings() const { return settings_; }
   const ShadowMap* shadow() const { return shadow_ ? &*shadow_ : nullptr; }
+  // The volume pass's convenience-call transfers (--host-transfer); nothing on the scalar path.
+  void set_host_transfer(HostTransfer transfer) {
+    if (pass_) pass_->set_host_transfer(transfer);
+  }
 
   // Composites the volumes onto `in` into `out` (the OpenCL pass, or the scalar path in float).
   // verbose: prints the variant (integrator, steps, resolution, visible volumes, build options),
