@@ -8,7 +8,9 @@ the input's pixel type (half in -> --pixel-type half) and compression. With --ba
 fogcl binary of before the pipeline (one thread, float output) runs on --baseline-cases too.
 
   bench/sequence_bench.py --bin build --out out/sequence [--threads 1,2,16] [--reps 3]
-                          [--cases 1080p-float-zip,...] [--baseline OLD_FOGCL] [--device cpu|scalar]
+                          [--cases 1080p-float-zip,...] [--baseline OLD_FOGCL] [--device cpu|gpu|scalar]
+                          [--frames N]  (every case with N frames: a long shot amortises the start-up)
+                          [--fogcl-args "..."]  (more fogcl apply arguments, e.g. "--host-transfer direct")
                           [--pin]   (runs with N threads on N cores: taskset -c 0-(N-1))
                           [--first-core K]  (with --pin: cores K..K+N-1; a VM's core 0 also
                                              serves its interrupts)
@@ -57,6 +59,8 @@ def main():
     ap.add_argument("--baseline", default=None)
     ap.add_argument("--baseline-cases", default="1080p-float-zip")
     ap.add_argument("--device", default="cpu")
+    ap.add_argument("--frames", type=int, default=0, help="frames of every case (default: the case's own)")
+    ap.add_argument("--fogcl-args", default="", help="more arguments of fogcl apply (e.g. --host-transfer direct)")
     ap.add_argument("--pin", action="store_true")
     ap.add_argument("--first-core", type=int, default=0)
     ap.add_argument("--scratch", default=None, help="where outputs are written (default OUT/scratch)")
@@ -71,9 +75,12 @@ def main():
 
     # Generate what is missing, several sequences at once.
     jobs = []
-    for c in cases:
+    def case(c):
         w, h, n, ptype, comp = CASES[c]
-        d = data / c
+        return (w, h, a.frames, ptype, comp, data / f"{c}-{a.frames}") if a.frames else (w, h, n, ptype, comp, data / c)
+
+    for c in cases:
+        w, h, n, ptype, comp, d = case(c)
         if not (d / f"depth.{n:04d}.exr").exists():
             d.mkdir(parents=True, exist_ok=True)
             jobs.append(subprocess.Popen([make, str(d), str(w), str(h), str(n), ptype, comp]))
@@ -99,14 +106,13 @@ def main():
     for rep in range(a.reps):
         for t in threads:
             for c in cases:
-                w, h, n, ptype, comp = CASES[c]
-                d = data / c
+                w, h, n, ptype, comp, d = case(c)
                 tools = {
                     "peer": [peer, f"{d}/color.%04d.exr", f"{d}/depth.%04d.exr", f"{scratch}/p.%04d.exr", "1", str(n),
                              str(t), ptype, "input"],
                     "fogcl": [fogcl, "apply", "--color", f"{d}/color.####.exr", "--depth", f"{d}/depth.####.exr",
                               "--out", f"{scratch}/f.####.exr", *FOG, "--threads", str(t), "--device", a.device,
-                              "--pixel-type", ptype],
+                              "--pixel-type", ptype, *a.fogcl_args.split()],
                 }
                 if a.baseline and c in a.baseline_cases.split(",") and t == threads[0]:  # one thread whatever t is
                     tools["before"] = [a.baseline, "apply", "--color", f"{d}/color.####.exr", "--depth",

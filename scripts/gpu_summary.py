@@ -110,7 +110,7 @@ if fog:
     p()
     p("| frame | mode | metric | color | device ms | GB/s | copy GB/s | bw_vs_copy | round trip ms | max err |")
     p("|---|---|---|---|---:|---:|---:|---:|---:|---:|")
-    modes = {"0": "linear", "1": "exp", "2": "exp2"}
+    modes = {"0": "linear", "1": "exp", "2": "exp2", "3": "height valley", "4": "height haze"}
     worst = {}
     for b in fog:
         if not b["base"].startswith("BM_OpenCLDevice/"):

@@ -246,6 +246,7 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
         s.integrator = VolumeIntegrator::riemann;
         s.steps = steps;
         s.resolution_divisor = 1;
+        s.noise_sampling = NoiseSampling::buffer;  // rows name what ran (the dense scene has no noise)
         jobs.push_back({scene, s, ColorFormat::rgba32f});
       }
   }
