@@ -15,6 +15,8 @@
 //   BM_OpenCLHostCall    the convenience call, host images in and out (enqueue to finish); on a
 //                        GPU the host round trip: upload + kernel + download. kernel_ms: its own
 //                        kernel's profiling time; call_vs_kernel: the call over it, same iterations
+//   BM_OpenCLHostCallPinned  the same with the host images in pinned memory (pinned_color_image):
+//                        on a GPU no staging copy, the images themselves cross the bus (exp2 only)
 //   BM_DeviceCopy        clEnqueueCopyBuffer of the pass's color and depth into device buffers
 //                        (profiling events): the device's own bandwidth ceiling, for GPUs
 //   BM_PinnedTransfer    the bytes a host round trip moves (color and depth up, color down) between
@@ -528,6 +530,33 @@ void BM_DeviceCopy(benchmark::State& state) {
   state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(copy.bytes_moved()));
 }
 
+// BM_OpenCLHostCall with the host images in pinned memory of the pass's context
+// (pinned_color_image / pinned_depth_image): on a GPU the staged call moves them over the bus
+// from where they are, without the staging copies. The output is copied to the row's `out`
+// outside the timing, for max_err.
+void BM_OpenCLHostCallPinned(benchmark::State& state) {
+  Runtime* rt = runtime(state);
+  if (rt == nullptr) return;
+  FogPass& pass = shared_pass(*rt);
+  ColorImage in, pinned_out;
+  DepthImage depth;
+  double kernel_ms = 0;
+  timed_fog(state, "opencl-host-pinned", [&](const DemoFrame& f, ColorImage& out, const FogSettings& s) {
+    if (in.width() != f.color.width() || in.format() != f.color.format()) {
+      in = pinned_color_image(rt->context(), rt->device(), f.color.width(), f.color.height(), f.color.format());
+      pinned_out = pinned_color_image(rt->context(), rt->device(), f.color.width(), f.color.height(), f.color.format());
+      depth = pinned_depth_image(rt->context(), rt->device(), f.depth.width(), f.depth.height());
+      std::memcpy(in.data(), f.color.data(), f.color.size_bytes());
+      std::memcpy(depth.data(), f.depth.data(), f.depth.size_bytes());
+    }
+    const double call = host_time([&] { pass.apply(in, depth, pinned_out, f.params, s); });
+    kernel_ms += pass.stats().last_kernel_ms;
+    std::memcpy(out.data(), pinned_out.data(), out.size_bytes());
+    return call;
+  });
+  state.counters["kernel_ms"] = kernel_ms / double(state.iterations());
+}
+
 // The bus's ceiling of a host round trip: a frame's input bytes (color_in and depth) written to
 // device buffers, then its output bytes (color_out) read back, on the pass's device and queue
 // (FOGCL_DEVICE). Both passes' convenience calls (FogPass::apply, VolumePass::apply) move exactly
@@ -1007,6 +1036,13 @@ BENCHMARK(BM_DeviceCopy)
     ->ArgNames({"w", "h", "f16"})
     ->ArgsProduct({{1920}, {1080}, {0, 1}})
     ->ArgsProduct({{3840}, {2160}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2);
+BENCHMARK(BM_OpenCLHostCallPinned)
+    ->ArgNames({"w", "h", "mode", "dist", "f16"})
+    ->ArgsProduct({{1920}, {1080}, {2}, {0}, {0, 1}})
+    ->ArgsProduct({{3840}, {2160}, {2}, {0}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2);

@@ -84,7 +84,7 @@ bench() {  # bench BINARY JSON FILTER [args...]
 if want bench; then
   echo "bench: deferred pass on the GPU"
   FOGCL_DEVICE=gpu bench fogcl_bench fog-gpu.json \
-    'BM_DeviceCopy|BM_OpenCLDevice/w:(1920|3840)/h:(1080|2160)/.*/nt:2|BM_OpenCLHostCall/w:(1920|3840)|BM_PinnedTransfer|BM_DispatchOverhead|BM_FirstDispatch|BM_ProgramBuild' \
+    'BM_DeviceCopy|BM_OpenCLDevice/w:(1920|3840)/h:(1080|2160)/.*/nt:2|BM_OpenCLHostCall/w:(1920|3840)|BM_OpenCLHostCallPinned|BM_PinnedTransfer|BM_DispatchOverhead|BM_FirstDispatch|BM_ProgramBuild' \
     --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
   echo "bench: volumetric pass on the GPU"
   FOGCL_DEVICE=gpu bench fogcl_volume_bench volume-gpu.json 'BM_VolumeDevice|BM_VolumeHostCall|BM_VolumeNothingVisible' \

@@ -203,6 +203,9 @@ if transfers:
         if b["base"].startswith("BM_OpenCLHostCall/") and a["w"] in ("1920", "3840"):
             what = f'deferred {modes.get(a["mode"], a["mode"])}{" distance" if a["dist"] == "1" else ""}'
             trips.append((what, a["w"], a["h"], a["f16"], b))
+        if b["base"].startswith("BM_OpenCLHostCallPinned/"):
+            what = f'deferred {modes.get(a["mode"], a["mode"])}, pinned images'
+            trips.append((what, a["w"], a["h"], a["f16"], b))
     for b in vol:
         a = args(b["base"])
         if b["base"].startswith("BM_VolumeHostCall/"):

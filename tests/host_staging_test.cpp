@@ -10,6 +10,7 @@
 
 #include "fogcl/fog_pass.h"
 #include "fogcl/volume_pass.h"
+#include "runtime/pinned_memory.h"
 #include "test_support.h"
 #include "volume_support.h"
 
@@ -131,6 +132,49 @@ TEST(HostStaging, TooManyFramesInFlightIsAnErrorNotAHang) {
   ColorImage out;
   p.staged.apply_async(f.color, f.depth, out, f.params, exp2_fog()).wait();
   EXPECT_EQ(differing_bytes(out, outs[0]), 0u);
+}
+
+// Pinned images cross the bus from where they are (no staging copy): the same bytes, in place
+// too, and the images are ordinary images otherwise (copies, pixel access, lifetime past the pass).
+TEST(HostStaging, PinnedImagesGoOverTheBusUncopiedWithTheSameBytes) {
+  FOGCL_REQUIRE_DEVICE();
+  const cl_context ctx = runtime()->context();
+  const cl_device_id dev = runtime()->device();
+  const TestFrame f = make_test_frame(333, 177, false, ColorFormat::rgba32f, 21);
+  ColorImage in = pinned_color_image(ctx, dev, f.color.width(), f.color.height(), f.color.format());
+  DepthImage depth = pinned_depth_image(ctx, dev, f.depth.width(), f.depth.height());
+  EXPECT_EQ(in.pixel(5, 5), glm::vec4(0.0f)) << "pinned pixels start zeroed";
+  // What the staging looks up: these images are pinned memory of this context, a copy is not.
+  EXPECT_TRUE(detail::is_pinned(in.data(), in.size_bytes(), ctx));
+  EXPECT_TRUE(detail::is_pinned(depth.data(), depth.size_bytes(), ctx));
+  EXPECT_FALSE(detail::is_pinned(in.data(), in.size_bytes() + 1, ctx));
+  EXPECT_FALSE(detail::is_pinned(f.color.data(), f.color.size_bytes(), ctx));
+  std::memcpy(in.data(), f.color.data(), f.color.size_bytes());
+  std::memcpy(depth.data(), f.depth.data(), f.depth.size_bytes());
+  ColorImage out = pinned_color_image(ctx, dev, in.width(), in.height(), in.format());
+  ColorImage want;
+  {
+    Passes p;
+    p.direct.apply(f.color, f.depth, want, f.params, exp2_fog());
+    p.staged.apply(in, depth, out, f.params, exp2_fog());
+    EXPECT_EQ(differing_bytes(out, want), 0u);
+    // Pinned input, ordinary output, and in place.
+    ColorImage plain;
+    p.staged.apply(in, depth, plain, f.params, exp2_fog());
+    EXPECT_EQ(differing_bytes(plain, want), 0u);
+    ColorImage frame = in;  // a copy is ordinary memory with the same pixels
+    EXPECT_EQ(differing_bytes(frame, in), 0u);
+    EXPECT_FALSE(detail::is_pinned(frame.data(), frame.size_bytes(), ctx));
+    p.staged.apply(in, depth, in, f.params, exp2_fog());
+    EXPECT_EQ(differing_bytes(in, want), 0u);
+    // The direct path (the CPU default) takes pinned images as any others.
+    ColorImage direct;
+    p.direct.apply(frame, depth, direct, f.params, exp2_fog());
+    EXPECT_EQ(differing_bytes(direct, want), 0u);
+  }
+  // The pass is gone; the images stay valid (they keep their buffers and context).
+  EXPECT_EQ(differing_bytes(out, want), 0u);
+  EXPECT_THROW(pinned_color_image(ctx, dev, 0, 4), Error);
 }
 
 TEST(HostStaging, VolumesSameBytesAsDirect) {

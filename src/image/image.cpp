@@ -40,7 +40,15 @@ const char* to_string(ColorFormat format) {
 }
 
 namespace detail {
-void AlignedBytes::Free::operator()(std::byte* p) const { std::free(p); }
+void AlignedBytes::Free::operator()(std::byte* p) {
+  if (owner)
+    owner.reset();
+  else
+    std::free(p);
+}
+
+AlignedBytes::AlignedBytes(std::byte* external, std::size_t size, std::shared_ptr<void> owner)
+    : data_(external, Free{std::move(owner)}), size_(size) {}
 
 AlignedBytes::AlignedBytes(std::size_t size) : size_(size) {
   const std::size_t alignment = size >= kHugePage ? kHugePage : kAlignment;
@@ -68,6 +76,15 @@ ColorImage::ColorImage(int width, int height, ColorFormat format)
     : width_(width), height_(height), format_(format) {
   check_size("color image", width, height);
   bytes_ = detail::AlignedBytes(size_bytes());
+}
+
+ColorImage::ColorImage(int width, int height, ColorFormat format, detail::AlignedBytes storage)
+    : width_(width), height_(height), format_(format) {
+  check_size("color image", width, height);
+  if (storage.size() < size_bytes())
+    throw Error("color image storage holds " + std::to_string(storage.size()) + " bytes, " +
+                std::to_string(size_bytes()) + " needed");
+  bytes_ = std::move(storage);
 }
 
 float* ColorImage::rgba32f() { return const_cast<float*>(std::as_const(*this).rgba32f()); }
@@ -114,6 +131,14 @@ DepthImage::DepthImage(int width, int height, float fill) : width_(width), heigh
   check_size("depth image", width, height);
   bytes_ = detail::AlignedBytes(size_bytes());
   std::fill(data(), data() + pixel_count(), fill);
+}
+
+DepthImage::DepthImage(int width, int height, detail::AlignedBytes storage) : width_(width), height_(height) {
+  check_size("depth image", width, height);
+  if (storage.size() < size_bytes())
+    throw Error("depth image storage holds " + std::to_string(storage.size()) + " bytes, " +
+                std::to_string(size_bytes()) + " needed");
+  bytes_ = std::move(storage);
 }
 
 void validate_frame(const ColorImage& color, const DepthImage& depth) {

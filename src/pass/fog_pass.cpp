@@ -10,6 +10,7 @@
 #include "runtime/clhpp.h"
 #include "runtime/frame_buffers.h"
 #include "runtime/host_staging.h"
+#include "runtime/pinned_memory.h"
 #include "settings/fog_coefficients.h"
 
 namespace fogcl {
@@ -201,6 +202,17 @@ cl_event FogPass::Impl::dispatch(const cl::CommandQueue& queue, const FrameBuffe
   return share(done);
 }
 
+ColorImage pinned_color_image(cl_context context, cl_device_id device, int width, int height, ColorFormat format) {
+  if (width < 1 || height < 1) return ColorImage(width, height, format);  // throws, naming the size
+  return ColorImage(width, height, format,
+                    detail::pinned_bytes(wrap(context), wrap(device), color_buffer_bytes(width, height, format)));
+}
+
+DepthImage pinned_depth_image(cl_context context, cl_device_id device, int width, int height) {
+  if (width < 1 || height < 1) return DepthImage(width, height);  // throws, naming the size
+  return DepthImage(width, height, detail::pinned_bytes(wrap(context), wrap(device), depth_buffer_bytes(width, height)));
+}
+
 const char* to_string(HostTransfer transfer) {
   switch (transfer) {
     case HostTransfer::automatic: return "automatic";
@@ -276,7 +288,7 @@ PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage&
   detail::StagedFrame frame = staging->upload(in, depth);
   done = adopt(dispatch(queue, frame.raw(), v, camera, settings, {frame.uploaded()()}));
   queue.flush();
-  staging->download(frame, done);
+  staging->download(frame, done, out);
   ++stats.copied_frames;
   PendingFrame pending;
   pending.impl_ = std::make_unique<PendingFrame::Impl>();

@@ -1,5 +1,7 @@
 #include "runtime/host_staging.h"
 
+#include "runtime/pinned_memory.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -72,9 +74,9 @@ void CopyWorkers::run(int n, const std::function<void(int)>& task) {
 // ---- slots -------------------------------------------------------------------------------------
 
 namespace {
-// Bands of ~4 MiB: large enough for the DMA engine's full rate, small enough that the first
+// Bands of ~2 MiB: large enough for the DMA engine's full rate, small enough that the first
 // transfer starts early and the copies spread over the threads.
-constexpr std::size_t kBandBytes = std::size_t(4) << 20;
+constexpr std::size_t kBandBytes = std::size_t(2) << 20;
 // A caller that never waits must not exhaust memory.
 constexpr long kMaxInFlight = 16;
 
@@ -101,6 +103,7 @@ struct StagingSlot {
   FrameBuffers raw;
   cl::Event uploaded, after;              // after: the passes' last event (download())
   std::vector<cl::Event> downloads;       // one per band of color_out
+  bool out_direct = false;                // downloaded into the caller's pinned image itself
   std::size_t color_bytes() const { return color_buffer_bytes(width, height, format); }
   std::size_t depth_bytes() const { return depth_buffer_bytes(width, height); }
 };
@@ -174,6 +177,7 @@ void HostStaging::give_back(StagingSlot* slot) {
   slot->uploaded = cl::Event();
   slot->after = cl::Event();
   slot->downloads.clear();
+  slot->out_direct = false;
   // Frames beyond max_frames in flight got slots of their own: keep max_frames slots' memory.
   if (int(slots_.size()) > max_frames_) {
     const auto it = std::find_if(slots_.begin(), slots_.end(), [&](const auto& s) { return s.get() == slot; });
@@ -242,26 +246,38 @@ StagedFrame HostStaging::upload(const ColorImage& in, const DepthImage& depth) {
   const std::vector<Band> color_bands = bands(color), depth_bands = bands(s.depth_bytes());
   const auto* color_src = static_cast<const std::byte*>(in.data());
   const auto* depth_src = reinterpret_cast<const std::byte*>(depth.data());
+  // A pinned image crosses the bus from where it is; the others through the slot's pinned memory.
+  const bool color_direct = is_pinned(color_src, color, context_());
+  const bool depth_direct = is_pinned(depth_src, s.depth_bytes(), context_());
+  if (color_direct) upload_queue_.enqueueWriteBuffer(s.color_in, CL_FALSE, 0, color, color_src);
+  if (depth_direct) upload_queue_.enqueueWriteBuffer(s.depth, CL_FALSE, 0, s.depth_bytes(), depth_src);
+  const std::size_t copied_color = color_direct ? 0 : color_bands.size();
+  const std::size_t copied_depth = depth_direct ? 0 : depth_bands.size();
   // Each band's DMA is enqueued by the thread that filled it, as soon as it is filled.
-  up_workers_.run(int(color_bands.size() + depth_bands.size()), [&](int i) {
-    const bool is_color = std::size_t(i) < color_bands.size();
-    const Band b = is_color ? color_bands[i] : depth_bands[i - color_bands.size()];
+  up_workers_.run(int(copied_color + copied_depth), [&](int i) {
+    const bool is_color = std::size_t(i) < copied_color;
+    const Band b = is_color ? color_bands[i] : depth_bands[i - copied_color];
     std::byte* pinned = s.in + (is_color ? 0 : color) + b.offset;
     std::memcpy(pinned, (is_color ? color_src : depth_src) + b.offset, b.bytes);
     upload_queue_.enqueueWriteBuffer(is_color ? s.color_in : s.depth, CL_FALSE, b.offset, b.bytes, pinned);
   });
   upload_queue_.enqueueMarkerWithWaitList(nullptr, &s.uploaded);
   upload_queue_.flush();
+  // The caller may change its images once this returns: the DMA from them must be over.
+  if (color_direct || depth_direct) s.uploaded.wait();
   return frame;
 }
 
-void HostStaging::download(StagedFrame& frame, const cl::Event& after) {
+void HostStaging::download(StagedFrame& frame, const cl::Event& after, ColorImage& out) {
   StagingSlot& s = *frame.slot_;
   s.after = after;
   const std::vector<cl::Event> wait{after};
+  auto* dst = static_cast<std::byte*>(out.data());
+  s.out_direct = is_pinned(dst, s.color_bytes(), context_());
   for (const Band& b : bands(s.color_bytes())) {
     cl::Event e;
-    download_queue_.enqueueReadBuffer(s.color_out, CL_FALSE, b.offset, b.bytes, s.out + b.offset, &wait, &e);
+    download_queue_.enqueueReadBuffer(s.color_out, CL_FALSE, b.offset, b.bytes, (s.out_direct ? dst : s.out) + b.offset,
+                                      &wait, &e);
     s.downloads.push_back(e);
   }
   download_queue_.flush();
@@ -276,7 +292,7 @@ void HostStaging::finish(StagedFrame& frame, ColorImage& out) {
   // Band b is copied out as soon as its DMA is done, while later bands still cross the bus.
   down_workers_.run(int(color_bands.size()), [&](int b) {
     s.downloads[b].wait();
-    std::memcpy(dst + color_bands[b].offset, s.out + color_bands[b].offset, color_bands[b].bytes);
+    if (!s.out_direct) std::memcpy(dst + color_bands[b].offset, s.out + color_bands[b].offset, color_bands[b].bytes);
   });
   frame.release();
 }

@@ -85,12 +85,16 @@ class HostStaging {
   HostStaging& operator=(const HostStaging&) = delete;
 
   // Copies in and depth (same size) into a free slot's pinned memory and enqueues their upload;
-  // returns when the host images are no longer needed (the DMA may still run).
+  // returns when the host images are no longer needed (the DMA from the slot may still run). An
+  // image in pinned memory of this context goes up from where it is, uncopied (then this waits
+  // for that DMA).
   StagedFrame upload(const ColorImage& in, const DepthImage& depth);
-  // Enqueues the download of frame.raw().color_out after `after` (the passes' last event).
-  void download(StagedFrame& frame, const cl::Event& after);
-  // Waits for the download and copies it into `out` (the frame's size and format); then the
-  // slot is free for the next upload. Thread-safe against upload() of other frames.
+  // Enqueues the download of frame.raw().color_out after `after` (the passes' last event), into
+  // `out` itself when it is pinned memory of this context (pinned_memory.h), else into the slot's.
+  void download(StagedFrame& frame, const cl::Event& after, ColorImage& out);
+  // Waits for the download and copies it into `out` (the frame's size and format, the image
+  // given to download()); then the slot is free for the next upload. Thread-safe against
+  // upload() of other frames.
   void finish(StagedFrame& frame, ColorImage& out);
 
   // Frames of each size whose buffers are kept (for tests and stats).

@@ -325,7 +325,7 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
       const cl::Event done = adopt(enqueue(m.queue(), staged.raw(), camera, scene, settings, shadow ? &sm : nullptr,
                                            {staged.uploaded()()}, max_eye));
       m.queue.flush();
-      m.staging->download(staged, done);
+      m.staging->download(staged, done, out);
       m.staging->finish(staged, out);
       return;
     }

@@ -60,6 +60,15 @@ enum class HostTransfer {
 };
 const char* to_string(HostTransfer transfer);
 
+// Host images in page-locked memory of `context` (CL_MEM_ALLOC_HOST_PTR, mapped for the image's
+// life), pixels zeroed: the staged convenience calls of passes in that context move them over
+// the bus from where they are, without a staging copy (docs/gpu.md: the round trip at the bus's
+// speed). Ordinary images otherwise; a copy of one is ordinary memory. Throws fogcl::ClError
+// when the context cannot allocate it.
+ColorImage pinned_color_image(cl_context context, cl_device_id device, int width, int height,
+                              ColorFormat format = ColorFormat::rgba32f);
+DepthImage pinned_depth_image(cl_context context, cl_device_id device, int width, int height);
+
 // A convenience call in flight (FogPass::apply_async): wait() blocks until its `out` holds the
 // result. Its pass must outlive it. The destructor waits too (and swallows errors: call wait()).
 class PendingFrame {

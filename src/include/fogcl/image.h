@@ -19,11 +19,14 @@ std::size_t bytes_per_pixel(ColorFormat format);
 const char* to_string(ColorFormat format);
 
 namespace detail {
-// Page-aligned, zero-initialised byte storage with value semantics.
+// Page-aligned, zero-initialised byte storage with value semantics. Or memory from elsewhere
+// (pinned host memory of an OpenCL context: FogPass::pinned_color_image), kept alive by `owner`;
+// a copy of it is ordinary memory.
 class AlignedBytes {
  public:
   AlignedBytes() = default;
   explicit AlignedBytes(std::size_t size);
+  AlignedBytes(std::byte* external, std::size_t size, std::shared_ptr<void> owner);
   AlignedBytes(const AlignedBytes& other);
   AlignedBytes& operator=(const AlignedBytes& other);
   AlignedBytes(AlignedBytes&&) noexcept = default;
@@ -33,7 +36,8 @@ class AlignedBytes {
 
  private:
   struct Free {
-    void operator()(std::byte* p) const;
+    std::shared_ptr<void> owner;  // external memory: released with it; else std::free
+    void operator()(std::byte* p);
   };
   std::unique_ptr<std::byte[], Free> data_;
   std::size_t size_ = 0;
@@ -47,6 +51,8 @@ class ColorImage {
   ColorImage() = default;
   // width, height >= 1 (throws fogcl::Error otherwise); pixels start as (0, 0, 0, 0).
   ColorImage(int width, int height, ColorFormat format = ColorFormat::rgba32f);
+  // Over `storage` (at least width * height pixels; throws otherwise), as FogPass's pinned images.
+  ColorImage(int width, int height, ColorFormat format, detail::AlignedBytes storage);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -80,6 +86,8 @@ class DepthImage {
   DepthImage() = default;
   // width, height >= 1; pixels start at `fill`.
   DepthImage(int width, int height, float fill = 0.0f);
+  // Over `storage` (at least width * height floats; throws otherwise), as FogPass's pinned images.
+  DepthImage(int width, int height, detail::AlignedBytes storage);
 
   int width() const { return width_; }
   int height() const { return height_; }
