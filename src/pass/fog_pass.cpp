@@ -44,9 +44,7 @@ struct FogPass::Impl {
   HostTransfer transfer = HostTransfer::automatic;
   std::unique_ptr<detail::HostStaging> staging;  // staged transfers: made on the first call
 
-  bool staged() const {
-    return transfer == HostTransfer::staged || (transfer == HostTransfer::automatic && !traits.cpu);
-  }
+  bool staged() const { return detail::uses_staging(transfer, traits.cpu); }
   // apply()'s checks and sizing of `out`; the variant, or nullopt when no device work is needed
   // (then `out` already holds the result).
   std::optional<Variant> begin_apply(FogPass& pass, const ColorImage& in, const DepthImage& depth, ColorImage& out,

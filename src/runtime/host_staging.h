@@ -51,6 +51,11 @@ class CopyWorkers {
   bool stop_ = false;
 };
 
+// Whether a convenience call with `transfer` stages its images on a device (cpu: a CPU device).
+inline bool uses_staging(HostTransfer transfer, bool cpu) {
+  return transfer == HostTransfer::staged || (transfer == HostTransfer::automatic && !cpu);
+}
+
 class HostStaging;
 struct StagingSlot;
 

@@ -49,9 +49,7 @@ struct VolumePass::Impl {
   std::string last_march_options, last_composite_options;
   HostTransfer transfer = HostTransfer::automatic;
   std::unique_ptr<detail::HostStaging> staging;  // staged transfers: made on the first call
-  bool staged() const {
-    return transfer == HostTransfer::staged || (transfer == HostTransfer::automatic && !traits.cpu);
-  }
+  bool staged() const { return detail::uses_staging(transfer, traits.cpu); }
 
   // The kernel of a built program, or nullptr (never builds; creates the kernel object when
   // another pass sharing the cache built the program). private_bytes: the host's bound of a work-item's
