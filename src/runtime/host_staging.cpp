@@ -1,9 +1,11 @@
 #include "runtime/host_staging.h"
 
-#include "runtime/pinned_memory.h"
+#include <sched.h>
 
 #include <algorithm>
 #include <cstring>
+
+#include "runtime/pinned_memory.h"
 
 namespace fogcl::detail {
 
@@ -144,8 +146,15 @@ void StagedFrame::release() {
 // ---- HostStaging -------------------------------------------------------------------------------
 
 namespace {
-// The bus moves ~55 GB/s, one core's memcpy ~10 (H100 host): up to 8 threads keep up with it.
-int copy_threads() { return int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u)); }
+// The bus moves 54 GB/s each way, one core's memcpy ~10 (H100 host): 8 threads copy 45-49 GB/s,
+// 12 or 16 no more (bench/results/gpu-h100-2026-11-25-round-trip/band-sweep.md). At most the CPUs
+// this process may run on.
+int copy_threads() {
+  cpu_set_t set;
+  const int cpus = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set)
+                                                                : int(std::thread::hardware_concurrency());
+  return std::clamp(cpus, 1, 8);
+}
 }  // namespace
 
 HostStaging::HostStaging(const cl::Context& context, const cl::Device& device, int max_frames)
