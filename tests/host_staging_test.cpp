@@ -113,6 +113,21 @@ TEST(HostStaging, FramesInFlightWaitedForOnAnotherThread) {
   for (int i = 0; i < 6; ++i) EXPECT_EQ(differing_bytes(got[i], want[i]), 0u) << "frame " << i;
 }
 
+// A frame in flight holds the staging it uses: its pass may go first.
+TEST(HostStaging, AFrameInFlightOutlivesItsPass) {
+  FOGCL_REQUIRE_DEVICE();
+  const TestFrame f = make_test_frame(96, 54, false, ColorFormat::rgba32f, 8);
+  ColorImage want, got;
+  PendingFrame pending;
+  {
+    Passes p;
+    p.direct.apply(f.color, f.depth, want, f.params, exp2_fog());
+    pending = p.staged.apply_async(f.color, f.depth, got, f.params, exp2_fog());
+  }
+  pending.wait();
+  EXPECT_EQ(differing_bytes(got, want), 0u);
+}
+
 TEST(HostStaging, TooManyFramesInFlightIsAnErrorNotAHang) {
   FOGCL_REQUIRE_DEVICE();
   Passes p;

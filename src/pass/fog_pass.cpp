@@ -42,7 +42,7 @@ struct FogPass::Impl {
   PassStats stats;
   Variant last_variant;
   HostTransfer transfer = HostTransfer::automatic;
-  std::unique_ptr<detail::HostStaging> staging;  // staged transfers: made on the first call
+  std::shared_ptr<detail::HostStaging> staging;  // staged transfers: the context's, from the first call
 
   bool staged() const { return detail::uses_staging(transfer, traits.cpu); }
   // apply()'s checks and sizing of `out`; the variant, or nullopt when no device work is needed
@@ -221,7 +221,7 @@ const char* to_string(HostTransfer transfer) {
 }
 
 struct PendingFrame::Impl {
-  detail::HostStaging* staging = nullptr;
+  std::shared_ptr<detail::HostStaging> staging;
   detail::StagedFrame frame;
   ColorImage* out = nullptr;
 };
@@ -281,7 +281,7 @@ std::optional<Variant> FogPass::Impl::begin_apply(FogPass& pass, const ColorImag
 PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                                          const Variant& v, const CameraParams& camera, const FogSettings& settings,
                                          cl::Event& done) {
-  if (staging == nullptr) staging = std::make_unique<detail::HostStaging>(context, device);
+  if (staging == nullptr) staging = detail::HostStaging::shared(context, device);
   // A throw before the download is queued drops `frame`, which waits for what was enqueued.
   detail::StagedFrame frame = staging->upload(in, depth);
   done = adopt(dispatch(queue, frame.raw(), v, camera, settings, {frame.uploaded()()}));
@@ -290,7 +290,7 @@ PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage&
   ++stats.copied_frames;
   PendingFrame pending;
   pending.impl_ = std::make_unique<PendingFrame::Impl>();
-  pending.impl_->staging = staging.get();
+  pending.impl_->staging = staging;
   pending.impl_->out = &out;
   pending.impl_->frame = std::move(frame);
   return pending;

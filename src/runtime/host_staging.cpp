@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 
 #include "runtime/pinned_memory.h"
 
@@ -156,6 +157,20 @@ int copy_threads() {
   return std::clamp(cpus, 1, 8);
 }
 }  // namespace
+
+std::shared_ptr<HostStaging> HostStaging::shared(const cl::Context& context, const cl::Device& device) {
+  static std::mutex mutex;
+  static std::map<std::pair<cl_context, cl_device_id>, std::weak_ptr<HostStaging>> stagings;
+  const std::lock_guard<std::mutex> lock(mutex);
+  // A live staging retains its context, so a key's handle is not reused while its entry can lock.
+  std::weak_ptr<HostStaging>& entry = stagings[{context(), device()}];
+  std::shared_ptr<HostStaging> staging = entry.lock();
+  if (staging == nullptr) {
+    staging = std::make_shared<HostStaging>(context, device);
+    entry = staging;
+  }
+  return staging;
+}
 
 HostStaging::HostStaging(const cl::Context& context, const cl::Device& device, int max_frames)
     : context_(context),

@@ -82,6 +82,10 @@ class StagedFrame {
 
 class HostStaging {
  public:
+  // The staging of (context, device), shared by every pass there (a frame's volumes and fog use
+  // the same slots); made on first use, freed with its last holder.
+  static std::shared_ptr<HostStaging> shared(const cl::Context& context, const cl::Device& device);
+
   // max_frames >= 1: the frames in flight whose slots stay allocated (three: upload, kernels and
   // download of consecutive frames). More may be in flight, up to 16 (then upload() throws).
   HostStaging(const cl::Context& context, const cl::Device& device, int max_frames = 3);

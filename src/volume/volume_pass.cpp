@@ -48,7 +48,7 @@ struct VolumePass::Impl {
   VolumePassStats stats;
   std::string last_march_options, last_composite_options;
   HostTransfer transfer = HostTransfer::automatic;
-  std::unique_ptr<detail::HostStaging> staging;  // staged transfers: made on the first call
+  std::shared_ptr<detail::HostStaging> staging;  // staged transfers: the context's, from the first call
   bool staged() const { return detail::uses_staging(transfer, traits.cpu); }
 
   // The kernel of a built program, or nullptr (never builds; creates the kernel object when
@@ -318,7 +318,7 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
       sm.depth = shadow_buffer();
     }
     if (m.staged()) {  // pinned staging (runtime/host_staging.h): the GPU default
-      if (m.staging == nullptr) m.staging = std::make_unique<detail::HostStaging>(m.context, m.device);
+      if (m.staging == nullptr) m.staging = detail::HostStaging::shared(m.context, m.device);
       detail::StagedFrame staged = m.staging->upload(in, depth);
       const cl::Event done = adopt(enqueue(m.queue(), staged.raw(), camera, scene, settings, shadow ? &sm : nullptr,
                                            {staged.uploaded()()}, max_eye));

@@ -70,7 +70,8 @@ ColorImage pinned_color_image(cl_context context, cl_device_id device, int width
 DepthImage pinned_depth_image(cl_context context, cl_device_id device, int width, int height);
 
 // A convenience call in flight (FogPass::apply_async): wait() blocks until its `out` holds the
-// result. Its pass must outlive it. The destructor waits too (and swallows errors: call wait()).
+// result. It may outlive its pass (it holds the staging it uses); its `out` must stay alive until
+// wait(). The destructor waits too (and swallows errors: call wait()).
 class PendingFrame {
  public:
   PendingFrame();
