@@ -361,6 +361,13 @@ TEST_F(Sequence, StagedTransfersOverlapFramesAndWriteTheBytesOfDirectOnes) {
   }
   // The volumes changed the frames: the comparison above covered their pass too.
   EXPECT_NE(file_bytes(path("out/" + frame_name("staged", 1))), file_bytes(path("out/" + frame_name("staged-volumes", 1))));
+  const CliRun scalar = run_cli(inputs() + " --device scalar --host-transfer staged --out " + path("out/s.####.exr"));
+  EXPECT_EQ(scalar.exit_code, 1) << scalar.output;
+  EXPECT_NE(scalar.output.find("fogcl: error: --host-transfer staged moves frames to an OpenCL device; the scalar "
+                               "path (--device scalar) has none"),
+            std::string::npos)
+      << scalar.output;
+  EXPECT_FALSE(fs::exists(path("out/" + frame_name("s", 1))));
   const CliRun bad = run_cli(inputs() + " --host-transfer pinned --out " + path("out/bad.####.exr"));
   EXPECT_EQ(bad.exit_code, 1) << bad.output;
   EXPECT_NE(bad.output.find("--host-transfer: pinned not in {auto,direct,staged}"), std::string::npos) << bad.output;

@@ -493,6 +493,9 @@ int run_apply(const ApplyOptions& o) {
     throw Error("--infinite-far is a perspective projection; it does not go with --ortho-size");
   if (o.max_error_given && o.precision_given)
     throw Error("give either --precision or --max-error (which picks the precision), not both");
+  if (o.host_transfer != "auto" && resolve_device_choice(o.device) == "scalar")
+    throw Error("--host-transfer " + o.host_transfer +
+                " moves frames to an OpenCL device; the scalar path (--device scalar) has none");
   if (o.pixel_type != "float" && o.pixel_type != "half")
     throw Error("--pixel-type must be half or float (got '" + o.pixel_type + "')");
   if (!o.compression.empty()) parse_exr_compression(o.compression);
