@@ -41,10 +41,9 @@ struct FogPass::Impl {
   cl::Kernel* last_kernel = nullptr;
   PassStats stats;
   Variant last_variant;
-  HostTransfer transfer = HostTransfer::automatic;
-  std::shared_ptr<detail::HostStaging> staging;  // staged transfers: the context's, from the first call
+  detail::ConvenienceTransfers transfers;
 
-  bool staged() const { return detail::uses_staging(transfer, traits.cpu); }
+  bool staged() const { return transfers.staged(traits.cpu); }
   // apply()'s checks and sizing of `out`; the variant, or nullopt when no device work is needed
   // (then `out` already holds the result).
   std::optional<Variant> begin_apply(FogPass& pass, const ColorImage& in, const DepthImage& depth, ColorImage& out,
@@ -226,20 +225,22 @@ struct PendingFrame::Impl {
   ColorImage* out = nullptr;
 };
 
-PendingFrame::PendingFrame() = default;
-PendingFrame::~PendingFrame() {
+namespace {
+// A frame given up (destroyed or overwritten) still completes; its error has no one to go to.
+void wait_quietly(PendingFrame& frame) noexcept {
   try {
-    wait();
+    frame.wait();
   } catch (...) {
   }
 }
+}  // namespace
+
+PendingFrame::PendingFrame() = default;
+PendingFrame::~PendingFrame() { wait_quietly(*this); }
 PendingFrame::PendingFrame(PendingFrame&&) noexcept = default;
 PendingFrame& PendingFrame::operator=(PendingFrame&& other) noexcept {
   if (this != &other) {
-    try {
-      wait();
-    } catch (...) {
-    }
+    wait_quietly(*this);
     impl_ = std::move(other.impl_);
   }
   return *this;
@@ -253,7 +254,7 @@ void PendingFrame::wait() {
 
 bool PendingFrame::done() const { return impl_ == nullptr; }
 
-void FogPass::set_host_transfer(HostTransfer transfer) { impl_->transfer = transfer; }
+void FogPass::set_host_transfer(HostTransfer transfer) { impl_->transfers.choice = transfer; }
 HostTransfer FogPass::host_transfer() const {
   return impl_->staged() ? HostTransfer::staged : HostTransfer::direct;
 }
@@ -281,16 +282,16 @@ std::optional<Variant> FogPass::Impl::begin_apply(FogPass& pass, const ColorImag
 PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                                          const Variant& v, const CameraParams& camera, const FogSettings& settings,
                                          cl::Event& done) {
-  if (staging == nullptr) staging = detail::HostStaging::shared(context, device);
-  // A throw before the download is queued drops `frame`, which waits for what was enqueued.
-  detail::StagedFrame frame = staging->upload(in, depth);
-  done = adopt(dispatch(queue, frame.raw(), v, camera, settings, {frame.uploaded()()}));
-  queue.flush();
-  staging->download(frame, done, out);
+  detail::HostStaging& staging = transfers.staging_of(context, device);
+  detail::StagedFrame frame = staging.start(in, depth, out, [&](const FrameBuffers& fb, const cl::Event& uploaded) {
+    done = adopt(dispatch(queue, fb, v, camera, settings, {uploaded()}));
+    queue.flush();
+    return done;
+  });
   ++stats.copied_frames;
   PendingFrame pending;
   pending.impl_ = std::make_unique<PendingFrame::Impl>();
-  pending.impl_->staging = staging;
+  pending.impl_->staging = transfers.staging;
   pending.impl_->out = &out;
   pending.impl_->frame = std::move(frame);
   return pending;

@@ -127,8 +127,6 @@ StagedFrame& StagedFrame::operator=(StagedFrame&& other) noexcept {
 
 StagedFrame::~StagedFrame() { release(); }
 
-const FrameBuffers& StagedFrame::raw() const { return slot_->raw; }
-const cl::Event& StagedFrame::uploaded() const { return slot_->uploaded; }
 
 // A frame given up before finish(): its commands may still use the slot's memory.
 void StagedFrame::release() {
@@ -158,6 +156,11 @@ int copy_threads() {
 }
 }  // namespace
 
+HostStaging& ConvenienceTransfers::staging_of(const cl::Context& context, const cl::Device& device) {
+  if (staging == nullptr) staging = HostStaging::shared(context, device);
+  return *staging;
+}
+
 std::shared_ptr<HostStaging> HostStaging::shared(const cl::Context& context, const cl::Device& device) {
   static std::mutex mutex;
   static std::map<std::pair<cl_context, cl_device_id>, std::weak_ptr<HostStaging>> stagings;
@@ -174,7 +177,6 @@ std::shared_ptr<HostStaging> HostStaging::shared(const cl::Context& context, con
 
 HostStaging::HostStaging(const cl::Context& context, const cl::Device& device, int max_frames)
     : context_(context),
-      device_(device),
       upload_queue_(context, device),
       download_queue_(context, device),
       max_frames_(std::max(1, max_frames)),
@@ -188,11 +190,6 @@ HostStaging::~HostStaging() {
     for (auto& s : slots_) unmap(*s);
   } catch (...) {
   }
-}
-
-std::size_t HostStaging::slots() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return slots_.size();
 }
 
 void HostStaging::give_back(StagingSlot* slot) {
@@ -289,6 +286,13 @@ StagedFrame HostStaging::upload(const ColorImage& in, const DepthImage& depth) {
   upload_queue_.flush();
   // The caller may change its images once this returns: the DMA from them must be over.
   if (color_direct || depth_direct) s.uploaded.wait();
+  return frame;
+}
+
+StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes) {
+  // A throw before the download is queued drops `frame`, which waits for what was enqueued.
+  StagedFrame frame = upload(in, depth);
+  download(frame, passes(frame.slot_->raw, frame.slot_->uploaded), out);
   return frame;
 }
 

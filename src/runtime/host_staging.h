@@ -51,17 +51,24 @@ class CopyWorkers {
   bool stop_ = false;
 };
 
-// Whether a convenience call with `transfer` stages its images on a device (cpu: a CPU device).
-inline bool uses_staging(HostTransfer transfer, bool cpu) {
-  return transfer == HostTransfer::staged || (transfer == HostTransfer::automatic && !cpu);
-}
-
 class HostStaging;
+
+// A pass's convenience-call transfers: the choice (set_host_transfer), and its context's staging
+// once a staged call has run.
+struct ConvenienceTransfers {
+  HostTransfer choice = HostTransfer::automatic;
+  std::shared_ptr<HostStaging> staging;
+  // Whether calls stage their images on a device (cpu: a CPU device).
+  bool staged(bool cpu) const {
+    return choice == HostTransfer::staged || (choice == HostTransfer::automatic && !cpu);
+  }
+  HostStaging& staging_of(const cl::Context& context, const cl::Device& device);
+};
+
 struct StagingSlot;
 
-// One frame's device buffers and pinned memory while it is in flight. `raw` names the device
-// buffers for the passes (color_out distinct from color_in); `uploaded` is the event the passes'
-// kernels wait for. Destroying it waits for its commands and frees the slot.
+// One frame's device buffers and pinned memory while it is in flight (HostStaging::start).
+// Destroying it waits for its commands and frees the slot.
 class StagedFrame {
  public:
   StagedFrame() = default;
@@ -69,9 +76,6 @@ class StagedFrame {
   StagedFrame& operator=(StagedFrame&& other) noexcept;
   ~StagedFrame();
   explicit operator bool() const { return slot_ != nullptr; }
-
-  const FrameBuffers& raw() const;
-  const cl::Event& uploaded() const;
 
  private:
   friend class HostStaging;
@@ -93,30 +97,27 @@ class HostStaging {
   HostStaging(const HostStaging&) = delete;
   HostStaging& operator=(const HostStaging&) = delete;
 
-  // Copies in and depth (same size) into a free slot's pinned memory and enqueues their upload;
-  // returns when the host images are no longer needed (the DMA from the slot may still run). An
-  // image in pinned memory of this context goes up from where it is, uncopied (then this waits
-  // for that DMA).
-  StagedFrame upload(const ColorImage& in, const DepthImage& depth);
-  // Enqueues the download of frame.raw().color_out after `after` (the passes' last event), into
-  // `out` itself when it is pinned memory of this context (pinned_memory.h), else into the slot's.
-  void download(StagedFrame& frame, const cl::Event& after, ColorImage& out);
-  // Waits for the download and copies it into `out` (the frame's size and format, the image
-  // given to download()); then the slot is free for the next upload. Thread-safe against
-  // upload() of other frames.
+  // A convenience call's round trip up to the result's download, with no host wait: in and depth
+  // (same size) go up through a free slot's pinned memory, passes(buffers, uploaded) enqueues the
+  // passes on the slot's device buffers after `uploaded` and returns their last event, and the
+  // download of buffers.color_out into `out` follows it. Returns once the host images may be
+  // reused (the DMA from the slot may still run); an image in pinned memory of this context
+  // (pinned_memory.h) crosses the bus from where it is, uncopied (then this waits for that DMA).
+  using Passes = std::function<cl::Event(const FrameBuffers& buffers, const cl::Event& uploaded)>;
+  StagedFrame start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes);
+  // Waits for the download and copies it into `out` (the image given to start()); then the slot
+  // is free for the next frame. Thread-safe against start() of other frames.
   void finish(StagedFrame& frame, ColorImage& out);
 
-  // Frames of each size whose buffers are kept (for tests and stats).
-  std::size_t slots() const;
-
  private:
+  StagedFrame upload(const ColorImage& in, const DepthImage& depth);
+  void download(StagedFrame& frame, const cl::Event& after, ColorImage& out);
   friend class StagedFrame;
   void give_back(StagingSlot* slot);
   void unmap(StagingSlot& slot);
   StagingSlot& take_slot(int width, int height, ColorFormat format);
 
   cl::Context context_;
-  cl::Device device_;
   cl::CommandQueue upload_queue_, download_queue_;
   int max_frames_;
   // Uploads (the passes' thread) and downloads (finish(), possibly another thread) copy at once.

@@ -47,9 +47,8 @@ struct VolumePass::Impl {
   std::map<std::tuple<int, unsigned, int>, std::pair<cl::Memory, cl::Event>> noise;
   VolumePassStats stats;
   std::string last_march_options, last_composite_options;
-  HostTransfer transfer = HostTransfer::automatic;
-  std::shared_ptr<detail::HostStaging> staging;  // staged transfers: the context's, from the first call
-  bool staged() const { return detail::uses_staging(transfer, traits.cpu); }
+  detail::ConvenienceTransfers transfers;
+  bool staged() const { return transfers.staged(traits.cpu); }
 
   // The kernel of a built program, or nullptr (never builds; creates the kernel object when
   // another pass sharing the cache built the program). private_bytes: the host's bound of a work-item's
@@ -279,7 +278,7 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
   });
 }
 
-void VolumePass::set_host_transfer(HostTransfer transfer) { impl_->transfer = transfer; }
+void VolumePass::set_host_transfer(HostTransfer transfer) { impl_->transfers.choice = transfer; }
 HostTransfer VolumePass::host_transfer() const {
   return impl_->staged() ? HostTransfer::staged : HostTransfer::direct;
 }
@@ -318,13 +317,15 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
       sm.depth = shadow_buffer();
     }
     if (m.staged()) {  // pinned staging (runtime/host_staging.h): the GPU default
-      if (m.staging == nullptr) m.staging = detail::HostStaging::shared(m.context, m.device);
-      detail::StagedFrame staged = m.staging->upload(in, depth);
-      const cl::Event done = adopt(enqueue(m.queue(), staged.raw(), camera, scene, settings, shadow ? &sm : nullptr,
-                                           {staged.uploaded()()}, max_eye));
-      m.queue.flush();
-      m.staging->download(staged, done, out);
-      m.staging->finish(staged, out);
+      detail::HostStaging& staging = m.transfers.staging_of(m.context, m.device);
+      detail::StagedFrame staged =
+          staging.start(in, depth, out, [&](const FrameBuffers& fb, const cl::Event& uploaded) {
+            const cl::Event done = adopt(enqueue(m.queue(), fb, camera, scene, settings, shadow ? &sm : nullptr,
+                                                 {uploaded()}, max_eye));
+            m.queue.flush();
+            return done;
+          });
+      staging.finish(staged, out);
       return;
     }
     const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
