@@ -25,6 +25,8 @@ fi
 fogcl=$(readlink -f "$1")
 here=$(cd "$(dirname "$0")" && pwd)
 camera_script=$here/../../examples/blender_camera.py
+# shellcheck source=tests/support/apt.sh
+. "$here/../support/apt.sh"
 started=$SECONDS
 
 say() { echo "blender test: $*"; }
@@ -42,17 +44,9 @@ skip_or_fail() {
 if ! command -v blender > /dev/null; then
   [ "$(id -u)" -eq 0 ] || skip_or_fail "blender is not installed and installing it needs root"
   command -v apt-get > /dev/null || skip_or_fail "blender is not installed and apt-get is missing"
-  export DEBIAN_FRONTEND=noninteractive
   install_started=$SECONDS
-  # A clean machine may not have package lists yet: update only then.
-  if [ -z "$(apt-cache policy blender 2> /dev/null)" ] ||
-     apt-cache policy blender 2> /dev/null | grep -q 'Candidate: (none)'; then
-    say "apt-get update (no candidate for blender yet)"
-    apt-get update -qq || skip_or_fail "apt-get update failed"
-  fi
-  say "installing blender"
-  apt-get install -y -qq --no-install-recommends -o DPkg::Lock::Timeout=120 blender > /dev/null ||
-    skip_or_fail "apt-get install blender failed"
+  apt_update_if_needed skip_or_fail blender
+  apt_install blender || skip_or_fail "apt-get install blender failed"
   say "blender installed in $((SECONDS - install_started)) s"
   started=$SECONDS  # the test's own time starts now
 fi

@@ -30,6 +30,8 @@ fogcl=$(readlink -f "$1")
 make_sequence=$(readlink -f "$2")
 example=$(readlink -f "$3")
 started=$SECONDS
+# shellcheck source=tests/support/apt.sh
+. "$(cd "$(dirname "$0")" && pwd)/../support/apt.sh"
 
 say() { echo "slurm test: $*"; }
 fail() {
@@ -53,13 +55,7 @@ missing() {
 }
 if missing; then
   command -v apt-get > /dev/null || fail "slurm-wlm and munge are not installed and apt-get is missing: install them"
-  export DEBIAN_FRONTEND=noninteractive
-  # A clean machine may not have package lists yet: update only then.
-  if apt-cache policy slurm-wlm munge 2> /dev/null | grep -q 'Candidate: (none)' ||
-     [ -z "$(apt-cache policy slurm-wlm 2> /dev/null)" ]; then
-    say "apt-get update (no candidate for slurm-wlm or munge yet)"
-    apt-get update -qq || fail "apt-get update failed"
-  fi
+  apt_update_if_needed fail slurm-wlm munge
   # The packages' own services stay down: the test runs its own daemons. Debian's policy-rc.d
   # (exit 101: "action forbidden") is honoured by invoke-rc.d and deb-systemd-invoke alike.
   policy=/usr/sbin/policy-rc.d
@@ -70,9 +66,8 @@ if missing; then
     chmod 755 "$policy"
     own_policy=1
   fi
-  say "installing slurm-wlm munge"
   install_ok=1
-  apt-get install -y -qq --no-install-recommends -o DPkg::Lock::Timeout=120 slurm-wlm munge > /dev/null || install_ok=0
+  apt_install slurm-wlm munge || install_ok=0
   if [ "$own_policy" -eq 1 ]; then
     rm -f "$policy"
     trap - EXIT
