@@ -168,6 +168,16 @@ class InputLimits : public testing::Test {
     channels.push_back(fixtures::depth_channel(f, "Z"));
     fixtures::write_flat(path(name), f, {{"", channels, false, false}});
   }
+  // A frame refused from its header alone: one line naming `message`, exit 1, little memory and
+  // time (nothing of its size allocated), and no output written.
+  void expect_refused_before_allocation(const MeasuredRun& r, const std::string& message) const {
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.lines(), 1) << r.output;
+    EXPECT_MSG_HAS(r.output, message);
+    EXPECT_LT(r.peak_mib, 200.0);
+    EXPECT_LT(r.seconds, 10.0);
+    EXPECT_FALSE(fs::exists(path("out.exr")));
+  }
   std::string dir_;
 };
 
@@ -230,15 +240,10 @@ TEST_F(InputLimits, AHugeDisplayWindowIsRefusedBeforeItIsAllocated) {
       run_measured("apply --color " + path("huge.exr") + kFog + " --max-memory 2G --out " + path("out.exr"));
   std::printf("[ 20000^2  ] %zu-byte file: exit %d in %.2f s, peak %.0f MiB: %s", fs::file_size(path("huge.exr")),
               r.exit_code, r.seconds, r.peak_mib, r.output.c_str());
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.lines(), 1) << r.output;
-  EXPECT_MSG_HAS(r.output,
-                 "fogcl: error: " + path("huge.exr") +
-                     ": a 20000x20000 frame (display window (0, 0)-(19999, 19999)) needs about 13.4 GiB "
-                     "(color 5.96 GiB, depth 1.49 GiB, output 5.96 GiB), more than 2.00 GiB (--max-memory 2G)");
-  EXPECT_LT(r.peak_mib, 200.0);
-  EXPECT_LT(r.seconds, 10.0);
-  EXPECT_FALSE(fs::exists(path("out.exr")));
+  expect_refused_before_allocation(
+      r, "fogcl: error: " + path("huge.exr") +
+             ": a 20000x20000 frame (display window (0, 0)-(19999, 19999)) needs about 13.4 GiB "
+             "(color 5.96 GiB, depth 1.49 GiB, output 5.96 GiB), more than 2.00 GiB (--max-memory 2G)");
 }
 
 // The shadow map is a frame too (loaded once a run): its display window is checked the same way.
@@ -252,14 +257,10 @@ TEST_F(InputLimits, AHugeShadowMapIsRefusedBeforeItIsAllocated) {
                                      " --light-view-proj 1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1 --max-memory 1G --out " +
                                      path("out.exr"));
   std::printf("[ shadow   ] exit %d in %.2f s, peak %.0f MiB: %s", r.exit_code, r.seconds, r.peak_mib, r.output.c_str());
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.lines(), 1) << r.output;
-  EXPECT_MSG_HAS(r.output, "fogcl: error: --shadow-map: " + path("shadow.exr") +
-                               ": a 20000x20000 shadow map (display window (0, 0)-(19999, 19999)) needs about 2.98 GiB "
-                               "(the map 1.49 GiB, its device copy 1.49 GiB), more than 1.00 GiB (--max-memory 1G)");
-  EXPECT_LT(r.peak_mib, 200.0);
-  EXPECT_LT(r.seconds, 10.0);
-  EXPECT_FALSE(fs::exists(path("out.exr")));
+  expect_refused_before_allocation(
+      r, "fogcl: error: --shadow-map: " + path("shadow.exr") +
+             ": a 20000x20000 shadow map (display window (0, 0)-(19999, 19999)) needs about 2.98 GiB "
+             "(the map 1.49 GiB, its device copy 1.49 GiB), more than 1.00 GiB (--max-memory 1G)");
 }
 
 // The default limit is half of the machine's memory: a 46000x46000 frame (the largest display
