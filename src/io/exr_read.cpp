@@ -381,6 +381,7 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
   out.parts = s.file->parts();
   out.layer = r.layer;
   const std::string prefix = r.layer.empty() ? "" : r.layer + ".";
+  ColorFormat color_format = ColorFormat::rgba32f;  // the color frame's storage, once its part is found
   // Once, before the first frame is allocated (the depth's when it comes first).
   bool announced = false;
   const auto before_allocating = [&](const Frame& f) {
@@ -389,7 +390,7 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
     ExrFrameShape shape;
     shape.windows = detail::to_windows(f.display, f.data);
     shape.color = r.read_color;
-    if (r.read_color) shape.color_format = color_storage(s, out.color_part, prefix, r);
+    if (r.read_color) shape.color_format = color_format;
     for (const int part : {out.color_part, out.depth_part})
       if (part >= 0) shape.deep = shape.deep || is_deep(s.file->header(part));
     r.before_allocating(shape);
@@ -409,6 +410,7 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
       throw Error(s.path + ": missing channel " + missing + " (channels present: " + channels_present(s) + ")" +
                   (r.layer.empty() ? "" : " for layer '" + r.layer + "'"));
     }
+    color_format = color_storage(s, out.color_part, prefix, r);
   }
   if (!r.depth_channel.empty()) {
     out.depth_part = find_part(s, {r.depth_channel}, out.color_part);
@@ -464,10 +466,9 @@ ExrInput read_source(Source& s, const ExrReadRequest& r) {
   const Frame f = frame_of(s, out.color_part, r, &out.windows);
   out.camera = camera_of(ch);
   out.compression = int(ch.compression());
-  const bool half = color_storage(s, out.color_part, prefix, r) == ColorFormat::rgba16f;
+  const bool half = color_format == ColorFormat::rgba16f;
   before_allocating(f);
-  out.color = color_frame(r.color_into, f, half ? ColorFormat::rgba16f : ColorFormat::rgba32f,
-                          read_leaves_gaps(f, is_deep(ch)));
+  out.color = color_frame(r.color_into, f, color_format, read_leaves_gaps(f, is_deep(ch)));
   if (is_deep(ch)) {
     out.deep = true;
     read_deep(s, out.color_part, f, r, prefix, out.color.rgba32f(), nullptr, "Z");
