@@ -154,6 +154,10 @@ float lens_fov_deg(const CameraCliOptions& o, float aspect) {
 std::optional<CameraPose> frame_pose(const CameraCliOptions& o, const VolumeCliOptions& v, const ExrInput& color,
                                      std::string* from) {
   if (!v.pose_per_frame) return std::nullopt;
+  return renderer_pose(o, color, from);
+}
+
+CameraPose renderer_pose(const CameraCliOptions& o, const ExrInput& color, std::string* from) {
   const Axes axes = o.axes_value.value_or(Axes::unity);
   if (o.matrix) {
     RendererCamera c;  // the fov is not needed here: the frame's comes from frame_camera

@@ -56,4 +56,8 @@ float lens_fov_deg(const CameraCliOptions& o, float aspect);
 std::optional<CameraPose> frame_pose(const CameraCliOptions& o, const VolumeCliOptions& volumes,
                                      const ExrInput& color, std::string* from);
 
+// frame_pose's conversion without asking the volume stage: the pose from --camera-to-world, else
+// from the color file (height fog's, which takes it whenever --eye/--forward/--up are not given).
+CameraPose renderer_pose(const CameraCliOptions& o, const ExrInput& color, std::string* from);
+
 }  // namespace fogcl::cli

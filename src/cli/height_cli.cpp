@@ -31,14 +31,6 @@ double parse_number(const std::string& flag, const std::string& text) {
   return d;
 }
 
-// "X,Y,Z" -> three numbers, or an error naming the flag.
-glm::dvec3 parse_triple(const std::string& flag, const std::string& text, const char* names = "X,Y,Z") {
-  const NumberList list = parse_number_list(text);
-  if (list.bad_part || list.numbers.size() != 3)
-    throw Error(flag + " must be three comma-separated numbers " + names + " (got '" + text + "')");
-  return {list.numbers[0], list.numbers[1], list.numbers[2]};
-}
-
 glm::vec3 non_negative_rgb(const std::string& flag, const std::string& text) {
   const glm::dvec3 c = parse_triple(flag, text, "R,G,B");
   for (int k = 0; k < 3; ++k)
@@ -183,9 +175,7 @@ std::optional<CameraPose> height_frame_pose(const ApplyOptions& ap, const ExrInp
     *from = ap.height.pose_from;
     return ap.height.pose;
   }
-  VolumeCliOptions per_frame = ap.volumes;  // the same conversion as the volumes' (cli/camera_cli.h)
-  per_frame.pose_per_frame = true;
-  return frame_pose(ap.camera, per_frame, color, from);
+  return renderer_pose(ap.camera, color, from);  // the same conversion as the volumes' (cli/camera_cli.h)
 }
 
 }  // namespace fogcl::cli

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "fogcl/error.h"
 
 namespace fogcl::cli {
@@ -49,6 +51,15 @@ inline std::vector<double> parse_numbers(const std::string& flag, const std::str
   if (list.numbers.size() != count)
     throw Error(flag + " must be " + what + " (got " + std::to_string(list.numbers.size()) + ")");
   return std::move(list.numbers);
+}
+
+// "X,Y,Z": exactly three numbers for `flag`, or "FLAG must be three comma-separated numbers NAMES
+// (got 'TEXT')"; each flag checks the range itself.
+inline glm::dvec3 parse_triple(const std::string& flag, const std::string& text, const char* names = "X,Y,Z") {
+  const NumberList list = parse_number_list(text);
+  if (list.bad_part || list.numbers.size() != 3)
+    throw Error(flag + " must be three comma-separated numbers " + names + " (got '" + text + "')");
+  return {list.numbers[0], list.numbers[1], list.numbers[2]};
 }
 
 }  // namespace fogcl::cli

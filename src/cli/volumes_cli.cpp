@@ -396,10 +396,7 @@ namespace {
 
 // "X,Y,Z" -> three finite floats, or an error naming the flag.
 glm::vec3 parse_vec3(const std::string& flag, const std::string& text) {
-  const NumberList list = parse_number_list(text);
-  if (list.bad_part || list.numbers.size() != 3)
-    throw Error(flag + " must be three comma-separated numbers X,Y,Z (got '" + text + "')");
-  const glm::vec3 v(float(list.numbers[0]), float(list.numbers[1]), float(list.numbers[2]));
+  const glm::vec3 v(parse_triple(flag, text));
   for (int k = 0; k < 3; ++k)  // as floats: 1e39 is inf
     if (!std::isfinite(v[k])) throw Error(flag + " must be finite (got '" + text + "')");
   return v;
