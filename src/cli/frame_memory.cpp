@@ -23,6 +23,15 @@ std::string window_text(const ExrWindows& w) {
          std::to_string(w.display_max.x) + ", " + std::to_string(w.display_max.y) + ")";
 }
 
+// Pixels lo..hi of a window's side (0 when empty).
+std::uint64_t extent(int lo, int hi) { return std::uint64_t(std::max<std::int64_t>(0, std::int64_t(hi) - lo + 1)); }
+
+// The volume pass's march target for a width x height frame: ceil(W / s) x ceil(H / s) pixels.
+std::uint64_t volume_target_pixels(std::uint64_t width, std::uint64_t height, int divisor) {
+  const std::uint64_t s = std::uint64_t(std::max(divisor, 1));
+  return ((width + s - 1) / s) * ((height + s - 1) / s);
+}
+
 // The first number in a cgroup file ("max" and unreadable files: 0, no limit).
 std::uint64_t cgroup_limit(const char* path) {
   std::ifstream in(path);
@@ -136,9 +145,6 @@ FrameMemoryNeeds frame_memory_needs(const ApplyOptions& o) {
 
 FrameMemoryPlan frame_memory(const ExrFrameShape& shape, const FrameMemoryNeeds& needs) {
   const ExrWindows& w = shape.windows;
-  const auto extent = [](int lo, int hi) {
-    return std::uint64_t(std::max<std::int64_t>(0, std::int64_t(hi) - lo + 1));
-  };
   const std::uint64_t width = extent(w.display_min.x, w.display_max.x),
                       height = extent(w.display_min.y, w.display_max.y);
   const std::uint64_t pixels = width * height;
@@ -151,11 +157,9 @@ FrameMemoryPlan frame_memory(const ExrFrameShape& shape, const FrameMemoryNeeds&
   if (needs.half_output && shape.color_format == ColorFormat::rgba32f) plan.parts.push_back({"conversion", pixels * 8});
   if (needs.png) plan.parts.push_back({"preview", pixels * 8});
   if (shape.deep) plan.parts.push_back({"deep tables", data_pixels * 52});
-  if (needs.volumes) {
-    const std::uint64_t s = std::uint64_t(std::max(needs.volume_divisor, 1));
-    const std::uint64_t low = ((width + s - 1) / s) * ((height + s - 1) / s);
-    plan.parts.push_back({"volume target", low * 20 + (needs.volumes_scalar ? pixels * 20 : 0)});
-  }
+  if (needs.volumes)
+    plan.parts.push_back({"volume target", volume_target_pixels(width, height, needs.volume_divisor) * 20 +
+                                               (needs.volumes_scalar ? pixels * 20 : 0)});
   return plan;
 }
 
@@ -164,16 +168,15 @@ void check_frame_memory(const std::string& path, const ExrFrameShape& shape, con
   const FrameMemoryPlan plan = frame_memory(shape, needs);
   if (plan.total() <= limit.bytes) return;
   const ExrWindows& w = shape.windows;
-  throw Error(path + ": a " + std::to_string(std::int64_t(w.display_max.x) - w.display_min.x + 1) + "x" +
-              std::to_string(std::int64_t(w.display_max.y) - w.display_min.y + 1) + " frame (display window " +
+  throw Error(path + ": a " + std::to_string(extent(w.display_min.x, w.display_max.x)) + "x" +
+              std::to_string(extent(w.display_min.y, w.display_max.y)) + " frame (display window " +
               window_text(w) + ") needs about " + memory_text(plan.total()) + " (" + plan.text() + "), more than " +
               memory_text(limit.bytes) + " (" + limit.source + ")");
 }
 
 void check_shadow_map_memory(const std::string& path, const ExrFrameShape& shape, const MemoryLimit& limit) {
   const ExrWindows& w = shape.windows;
-  const std::uint64_t width = std::uint64_t(std::int64_t(w.display_max.x) - w.display_min.x + 1);
-  const std::uint64_t height = std::uint64_t(std::int64_t(w.display_max.y) - w.display_min.y + 1);
+  const std::uint64_t width = extent(w.display_min.x, w.display_max.x), height = extent(w.display_min.y, w.display_max.y);
   const std::uint64_t bytes = width * height * 8;
   if (bytes <= limit.bytes) return;
   throw Error(path + ": a " + std::to_string(width) + "x" + std::to_string(height) + " shadow map (display window " +
@@ -190,11 +193,8 @@ void check_device_allocations(const std::string& path, const Runtime& runtime, i
   const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
   std::vector<std::pair<std::string, std::uint64_t>> buffers = {{"color", pixels * bytes_per_pixel(format)},
                                                                 {"depth", pixels * 4}};
-  if (needs.volumes && !needs.volumes_scalar) {
-    const std::uint64_t s = std::uint64_t(std::max(needs.volume_divisor, 1));
-    buffers.push_back(
-        {"volume target", ((std::uint64_t(width) + s - 1) / s) * ((std::uint64_t(height) + s - 1) / s) * 16});
-  }
+  if (needs.volumes && !needs.volumes_scalar)
+    buffers.push_back({"volume target", volume_target_pixels(width, height, needs.volume_divisor) * 16});
   for (const auto& [name, bytes] : buffers)
     if (bytes > max_alloc)
       throw Error(path + ": a " + std::to_string(width) + "x" + std::to_string(height) + " " + to_string(format) +
