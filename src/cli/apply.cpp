@@ -171,9 +171,9 @@ struct InputFrames {
   DepthImage depth;
 };
 
-// Reads a frame's color and depth and derives its camera (reader thread). spare: frames to read
-// into when they fit (may be null).
-void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullptr) {
+// Reads a frame's color and depth and derives its camera (reader thread). limit: --max-memory's,
+// the run's. spare: frames to read into when they fit (may be null).
+void read_frame(const ApplyOptions& o, const MemoryLimit& limit, FrameJob& job, InputFrames* spare = nullptr) {
   const FramePaths& paths = job.paths;
   const DepthKind kind = parse_depth_kind(o.depth_kind);
   // Outside the depth's data window (and in empty deep pixels) there is nothing: background.
@@ -192,7 +192,6 @@ void read_frame(const ApplyOptions& o, FrameJob& job, InputFrames* spare = nullp
   }
   // What the frame will need is checked from its header, before anything is allocated.
   const FrameMemoryNeeds needs = frame_memory_needs(o);
-  const MemoryLimit limit = memory_limit(o.max_memory);
   request.before_allocating = [&](const ExrFrameShape& shape) { check_frame_memory(paths.color, shape, needs, limit); };
   job.color = read_exr(paths.color, request);
   const ExrInput& color = job.color;
@@ -486,7 +485,7 @@ int sweep_stale_temporaries(const FramePattern& pattern) {
 
 int run_apply(const ApplyOptions& o) {
   parse_depth_kind(o.depth_kind);  // a bad kind fails before any file is touched
-  memory_limit(o.max_memory);      // so does a bad --max-memory
+  const MemoryLimit memory = memory_limit(o.max_memory);  // so does a bad --max-memory
   if (o.fov != 0.0f && o.ortho_size != 0.0f)
     throw Error("give either --fov (perspective) or --ortho-size (orthographic), not both");
   if (o.ortho_size != 0.0f && o.infinite_far)
@@ -522,7 +521,7 @@ int run_apply(const ApplyOptions& o) {
     check_frame_files(o, job.paths);  // before anything is read or written
     const int swept = detail::remove_stale_temporaries_of({o.out_path, o.png_path});
     if (o.verbose && swept > 0) std::fprintf(stderr, "removed %d stale temporary file(s) of killed runs\n", swept);
-    std::future<void> reading = std::async(std::launch::async, [&] { read_frame(o, job); });
+    std::future<void> reading = std::async(std::launch::async, [&] { read_frame(o, memory, job); });
     std::promise<std::shared_ptr<Devices>> opened;
     open_devices(o, opened);
     reading.get();  // a bad input is named whether or not the device opened
@@ -609,7 +608,7 @@ int run_apply(const ApplyOptions& o) {
     const bool first = f == frames.front();
     try {
       check_frame_files(o, job.paths);
-      read_frame(o, job, &spare);
+      read_frame(o, memory, job, &spare);
     } catch (...) {
       if (first && tiered) first_variant.set_value(std::nullopt);
       throw;
