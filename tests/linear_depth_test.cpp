@@ -45,9 +45,7 @@ DepthImage linear_frame(int w, int h, DepthKind kind, const CameraParams& unit_p
   if (kind == DepthKind::distance) {
     // eye -> radial distance with the same geometry the library uses (exact enough: the
     // reference reads the value as given).
-    DepthImage ones(w, h);
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) ones.at(x, y) = 1.0f;
+    DepthImage ones(w, h, 1.0f);
     CameraParams p = unit_params;
     p.depth_kind = DepthKind::raw;
     // to_eye_depth(1) gives 1 / |ray1|: the pixel's ray length at view z = 1 is its inverse.
@@ -100,30 +98,28 @@ TEST(LinearDepth, FactorWithinBudgetForEveryNearPlane) {
       const DepthImage depth = linear_frame(w, h, kind, camera_params(near_plane, false, DepthKind::raw));
       // Linear depth reads no Z direction: conventional Z here (reversed in SkyAtInfinity), the
       // skybox test on for distance-based fog only, so that each program is built once.
-      for (bool reversed : {false}) {
-        const CameraParams p = camera_params(near_plane, reversed, kind);
-        for (const Case& c : cases)
-          for (FogMetric metric : {FogMetric::depth, FogMetric::distance}) {
-            const bool skybox = metric == FogMetric::distance;
-            const FogSettings s = settings_for(c, metric, skybox, SkyDistance::far_plane);
-            const Errors e = factor_errors(depth, p, s);
-            EXPECT_EQ(shared_pass().last_variant().depth_kind, kind);
-            EXPECT_LE(e.kernel, kLinearFactorBudget) << "near " << near_plane << " " << to_string(kind) << " "
-                                                     << to_string(c.mode) << " " << to_string(metric);
-            EXPECT_LE(e.scalar, kLinearFactorBudget) << "near " << near_plane << " " << to_string(kind);
-            worst = std::max({worst, e.kernel, e.scalar});
-            // The route linear depth took before: through float raw depth (to_raw_depth), measured
-            // against the same exact reference.
-            DepthImage raw = depth;
-            CameraParams raw_params = p;
-            raw_params.depth_kind = DepthKind::raw;
-            to_raw_depth(raw, kind, raw_params);
-            const ColorImage white = white_like(ColorImage(w, h, ColorFormat::rgba32f));
-            ColorImage via_raw;
-            apply_fog_scalar(white, raw, via_raw, raw_params, s);
-            worst_raw_route = std::max(worst_raw_route, factor_error(via_raw, fog_scalar<double>(white, depth, p, s)));
-          }
-      }
+      const CameraParams p = camera_params(near_plane, false, kind);
+      for (const Case& c : cases)
+        for (FogMetric metric : {FogMetric::depth, FogMetric::distance}) {
+          const bool skybox = metric == FogMetric::distance;
+          const FogSettings s = settings_for(c, metric, skybox, SkyDistance::far_plane);
+          const Errors e = factor_errors(depth, p, s);
+          EXPECT_EQ(shared_pass().last_variant().depth_kind, kind);
+          EXPECT_LE(e.kernel, kLinearFactorBudget) << "near " << near_plane << " " << to_string(kind) << " "
+                                                   << to_string(c.mode) << " " << to_string(metric);
+          EXPECT_LE(e.scalar, kLinearFactorBudget) << "near " << near_plane << " " << to_string(kind);
+          worst = std::max({worst, e.kernel, e.scalar});
+          // The route linear depth took before: through float raw depth (to_raw_depth), measured
+          // against the same exact reference.
+          DepthImage raw = depth;
+          CameraParams raw_params = p;
+          raw_params.depth_kind = DepthKind::raw;
+          to_raw_depth(raw, kind, raw_params);
+          const ColorImage white = white_like(ColorImage(w, h, ColorFormat::rgba32f));
+          ColorImage via_raw;
+          apply_fog_scalar(white, raw, via_raw, raw_params, s);
+          worst_raw_route = std::max(worst_raw_route, factor_error(via_raw, fog_scalar<double>(white, depth, p, s)));
+        }
       std::printf("[ worst    ] near %-7g %-8s linear kernel/scalar f %.2e (budget %.0e) | through raw depth %.2e\n",
                   double(near_plane), to_string(kind), worst, kLinearFactorBudget, worst_raw_route);
       if (near_plane == 1e-6f) worst_tiny_near_raw_route = std::max(worst_tiny_near_raw_route, worst_raw_route);
