@@ -46,6 +46,10 @@ def args(name):
     return dict(re.findall(r"(\w+):(\d+)", name))
 
 
+# fog_bench.cpp's mode argument.
+MODES = {"0": "linear", "1": "exp", "2": "exp2", "3": "height valley", "4": "height haze"}
+
+
 with open(os.path.join(results, "machine.txt")) if os.path.exists(os.path.join(results, "machine.txt")) else open(os.devnull) as f:
     p("# fogcl on the GPU machine")
     p()
@@ -110,7 +114,6 @@ if fog:
     p()
     p("| frame | mode | metric | color | device ms | GB/s | copy GB/s | bw_vs_copy | round trip ms | max err |")
     p("|---|---|---|---|---:|---:|---:|---:|---:|---:|")
-    modes = {"0": "linear", "1": "exp", "2": "exp2", "3": "height valley", "4": "height haze"}
     worst = {}
     for b in fog:
         if not b["base"].startswith("BM_OpenCLDevice/"):
@@ -122,7 +125,7 @@ if fog:
         ratio = b.get("bw_vs_copy", float("nan"))
         if a["w"] == "3840":
             worst[fmt] = min(worst.get(fmt, 9e9), ratio)
-        p(f'| {a["w"]}x{a["h"]} | {modes[a["mode"]]} | {"distance" if a["dist"] == "1" else "depth"} | {fmt} '
+        p(f'| {a["w"]}x{a["h"]} | {MODES[a["mode"]]} | {"distance" if a["dist"] == "1" else "depth"} | {fmt} '
           f'| {ms(b):.4f} | {b["bytes_per_second"] / 1e9:.0f} '
           f'| {copy["bytes_per_second"] / 1e9 if copy else float("nan"):.0f} | {ratio:.2f} '
           f'| {ms(rt) if rt else float("nan"):.2f} | {b.get("max_err", float("nan")):.2g} |')
@@ -197,14 +200,13 @@ for b in fog:
         transfers[(a["w"], a["h"], a["f16"], a["host"])] = b
 if transfers:
     trips = []
-    modes = {"0": "linear", "1": "exp", "2": "exp2", "3": "height valley", "4": "height haze"}
     for b in fog:
         a = args(b["base"])
         if b["base"].startswith("BM_OpenCLHostCall/") and a["w"] in ("1920", "3840"):
-            what = f'deferred {modes.get(a["mode"], a["mode"])}{" distance" if a["dist"] == "1" else ""}'
+            what = f'deferred {MODES.get(a["mode"], a["mode"])}{" distance" if a["dist"] == "1" else ""}'
             trips.append((what, a["w"], a["h"], a["f16"], b))
         if b["base"].startswith("BM_OpenCLHostCallPinned/"):
-            what = f'deferred {modes.get(a["mode"], a["mode"])}, pinned images'
+            what = f'deferred {MODES.get(a["mode"], a["mode"])}, pinned images'
             trips.append((what, a["w"], a["h"], a["f16"], b))
     for b in vol:
         a = args(b["base"])
