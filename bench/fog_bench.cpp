@@ -157,24 +157,22 @@ struct CopyTimes {
   int count[kCopyWays] = {};
   int next = 0;
 
-  // One copy of the next available way (round robin), timed.
-  void copy_one(const DemoFrame& f, ColorImage& out, DepthImage& scratch) {
-    while (!copy_way_available(next % kCopyWays)) ++next;
-    const int way = next++ % kCopyWays;
+  // One copy of `way`, timed.
+  void copy(const DemoFrame& f, ColorImage& out, DepthImage& scratch, int way) {
     const auto a = Clock::now();
     copy_bytes(f, out, scratch, kThreads, way);
     sum[way] += seconds_since(a);
     ++count[way];
   }
+  // One copy of the next available way (round robin), timed.
+  void copy_one(const DemoFrame& f, ColorImage& out, DepthImage& scratch) {
+    while (!copy_way_available(next % kCopyWays)) ++next;
+    copy(f, out, scratch, next++ % kCopyWays);
+  }
   // Copies until every available way has `n` copies.
   void fill(const DemoFrame& f, ColorImage& out, DepthImage& scratch, int n) {
     for (int way = 0; way < kCopyWays; ++way)
-      while (copy_way_available(way) && count[way] < n) {
-        const auto a = Clock::now();
-        copy_bytes(f, out, scratch, kThreads, way);
-        sum[way] += seconds_since(a);
-        ++count[way];
-      }
+      while (copy_way_available(way) && count[way] < n) copy(f, out, scratch, way);
   }
   double mean(int way) const { return count[way] ? sum[way] / count[way] : 0.0; }
   // The fastest way's mean time [s] and the way.
