@@ -357,10 +357,7 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
                                                        : "direct (the device uses the images' memory)");
     std::fprintf(stderr, "camera: %s\n", job.camera_text.c_str());
     if (settings.mode == FogMode::height && params.pose)  // --mode height: the pose its rays come from
-      std::fprintf(stderr, "height fog pose (fogcl's world): eye (%g, %g, %g), forward (%g, %g, %g), up (%g, %g, %g), from %s\n",
-                   double(params.pose->eye.x), double(params.pose->eye.y), double(params.pose->eye.z),
-                   double(params.pose->forward.x), double(params.pose->forward.y), double(params.pose->forward.z),
-                   double(params.pose->up.x), double(params.pose->up.y), double(params.pose->up.z),
+      std::fprintf(stderr, "height fog pose (fogcl's world): %s, from %s\n", pose_text(*params.pose).c_str(),
                    job.height_pose_from.c_str());
     std::fprintf(stderr, "depth: %s, channel %s%s\n", to_string(kind), o.depth_channel.c_str(),
                  color.deep ? " (deep color, flattened)" : "");

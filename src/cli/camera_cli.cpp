@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include <CLI/CLI.hpp>
@@ -181,6 +182,14 @@ CameraPose renderer_pose(const CameraCliOptions& o, const ExrInput& color, std::
     throw Error(color.path + ": worldToCamera: " + e.what() +
                 (o.axes_value ? "" : " (fogcl's world is left-handed, +y up: give the renderer's --axes)"));
   }
+}
+
+std::string pose_text(const CameraPose& p) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "eye (%g, %g, %g), forward (%g, %g, %g), up (%g, %g, %g)", double(p.eye.x),
+                double(p.eye.y), double(p.eye.z), double(p.forward.x), double(p.forward.y), double(p.forward.z),
+                double(p.up.x), double(p.up.y), double(p.up.z));
+  return buf;
 }
 
 }  // namespace fogcl::cli

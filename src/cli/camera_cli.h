@@ -60,4 +60,7 @@ std::optional<CameraPose> frame_pose(const CameraCliOptions& o, const VolumeCliO
 // from the color file (height fog's, which takes it whenever --eye/--forward/--up are not given).
 CameraPose renderer_pose(const CameraCliOptions& o, const ExrInput& color, std::string* from);
 
+// "eye (X, Y, Z), forward (X, Y, Z), up (X, Y, Z)" (%g), for --verbose.
+std::string pose_text(const CameraPose& pose);
+
 }  // namespace fogcl::cli

@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cli/camera_cli.h"
 #include "cli/frame_memory.h"
 #include "cli/number_list.h"
 #include "cli/usage.h"
@@ -730,10 +731,8 @@ void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImag
       "volumes: %zu of %zu visible (%s), %s integrator, %d steps, %s resolution (%dx%d target), %s upsampling\n",
       visible, scene.volumes.size(), options_.volumes_path.c_str(), to_string(settings_.integrator), settings_.steps,
       resolution_name(s), (in.width() + s - 1) / s, (in.height() + s - 1) / s, to_string(settings_.upsampling));
-  const CameraPose& p = scene.pose;
-  std::fprintf(stderr, "  camera pose (fogcl's world): eye (%g, %g, %g), forward (%g, %g, %g), up (%g, %g, %g), from %s\n",
-               double(p.eye.x), double(p.eye.y), double(p.eye.z), double(p.forward.x), double(p.forward.y),
-               double(p.forward.z), double(p.up.x), double(p.up.y), double(p.up.z), pose_from_.c_str());
+  std::fprintf(stderr, "  camera pose (fogcl's world): %s, from %s\n", pose_text(scene.pose).c_str(),
+               pose_from_.c_str());
   std::fprintf(stderr, "  noise: %d^3 texels, seed %u, %s sampling; shadow map: %s\n", settings_.noise_size,
                unsigned(settings_.noise_seed),
                pass_ ? to_string(pass_->noise_sampling(settings_.noise_sampling)) : "trilinear (scalar)",
