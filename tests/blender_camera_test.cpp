@@ -20,8 +20,6 @@
 
 #include <glm/geometric.hpp>
 
-#include "fogcl/demo_scene.h"
-#include "fogcl/exr_io.h"
 #include "fogcl/renderer_camera.h"
 #include "test_support.h"
 
@@ -158,11 +156,9 @@ TEST(BlenderCamera, ScriptFlagsGiveBlendersRays) {
     }
     if (std::string(c.name) == "landscape") {
       // fogcl apply takes the line as printed (a 64x36 frame: Blender's 640x360 aspect).
-      const DemoFrame frame = render_demo_scene(64, 36);
-      write_exr_rgba(dir + "/scene.exr", frame.color);
-      write_exr_depth(dir + "/depth.exr", frame.depth);
+      write_demo_scene(dir, 64, 36);
       const CliRun r = run_cli("apply --device scalar --color " + dir + "/scene.exr --depth " + dir +
-                               "/depth.exr --mode exp --density 0.01 --verbose --out " + dir + "/out.exr " + line);
+                               "/scene-depth.exr --mode exp --density 0.01 --verbose --out " + dir + "/out.exr " + line);
       EXPECT_EQ(r.exit_code, 0) << r.output;
       char fov[64];
       std::snprintf(fov, sizeof fov, "fov %g deg", double(cam.fov_y_deg));
