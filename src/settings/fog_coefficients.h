@@ -8,6 +8,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "camera/camera_basis.h"
 #include "fogcl/camera.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/variant.h"
@@ -78,9 +79,8 @@ HeightCoefficients<T> height_coefficients(const FogSettings& s, const CameraPara
     c.p[FOG_HP_FOG + k] = T(s.color[k]);
   }
   const CameraPose pose = cam.pose.value_or(CameraPose{});
-  const glm::dvec3 f = glm::normalize(glm::dvec3(pose.forward));
-  const glm::dvec3 r = glm::normalize(glm::cross(glm::dvec3(pose.up), f));
-  const glm::dvec3 u = glm::cross(f, r);
+  const CameraBasis b = camera_basis(pose);
+  const glm::dvec3 &r = b.right, &u = b.up, &f = b.forward;
   c.d0 = T(double(pose.eye.y) - double(h.base_height));
   c.up[0] = T(r.y);
   c.up[1] = T(u.y);

@@ -9,6 +9,7 @@
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 
+#include "camera/camera_basis.h"
 #include "fogcl/error.h"
 #include "fogcl/volume_pass.h"
 #include "runtime/format.h"
@@ -154,14 +155,13 @@ NoiseSampling resolve_noise_sampling(NoiseSampling requested, const NoiseSamplin
 }
 
 namespace {
-// The camera's rotation, view -> world (docs/volumetric.md §World and rays): columns right, up', forward.
+// The camera's rotation, view -> world (camera/camera_basis.h) in float: columns right, up', forward.
 struct Basis {
   glm::vec3 right, up, forward;
 };
-Basis camera_basis(const CameraPose& p) {
-  const glm::dvec3 f = glm::normalize(glm::dvec3(p.forward));
-  const glm::dvec3 r = glm::normalize(glm::cross(glm::dvec3(p.up), f));
-  return {glm::vec3(r), glm::vec3(glm::cross(f, r)), glm::vec3(f)};
+Basis float_basis(const CameraPose& p) {
+  const detail::CameraBasis b = detail::camera_basis(p);
+  return {glm::vec3(b.right), glm::vec3(b.up), glm::vec3(b.forward)};
 }
 
 // Culling in view space: side planes through the corner rays (or the orthographic box), near
@@ -194,7 +194,7 @@ bool volume_visible(const FogVolume& v, const Basis& b, const CameraPose& pose, 
 std::vector<std::size_t> visible_volumes(const VolumeScene& scene, const CameraParams& camera, float max_eye_depth) {
   validate(scene);
   validate(camera);
-  const Basis b = camera_basis(scene.pose);
+  const Basis b = float_basis(scene.pose);
   std::vector<std::size_t> visible;
   for (std::size_t i = 0; i < scene.volumes.size(); ++i)
     if (volume_visible(scene.volumes[i], b, scene.pose, camera, max_eye_depth)) visible.push_back(i);
@@ -310,7 +310,7 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   }
 
   float* k = out.frame.data();
-  const Basis b = camera_basis(scene.pose);
+  const Basis b = float_basis(scene.pose);
   const auto put3 = [&](int at, const glm::vec3& x) { k[at] = x.x, k[at + 1] = x.y, k[at + 2] = x.z; };
   put3(VOL_F_EYE, scene.pose.eye);
   put3(VOL_F_RIGHT, b.right);
