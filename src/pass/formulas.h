@@ -80,17 +80,22 @@ inline float fog_expm1(float x) { return fog_expm1_neg_poly(x); }
 inline float fog_log1p(float x) { return fog_log1p_neg_poly(x); }
 inline float fog_exp_expm1(float x, float* expm1_x) { return fog_exp_expm1_neg_poly(x, expm1_x); }
 
-// The ray term of a pixel (fog_ray_term: |ray(u, v)|, or its square where `squared`): each
-// component interpolated from the frustum corners (fog_bilerp). The kernel composes the same
-// formulas on its vector types. Always inlined: it sits in per-pixel loops that are vectorised or
-// compiled for FMA (scalar_fog.cpp).
+// The ray of a pixel: each component interpolated from the frustum corners (fog_bilerp). The
+// kernel composes the same formulas on its vector types. Always inlined: it sits in per-pixel
+// loops that are vectorised or compiled for FMA (scalar_fog.cpp).
+template <class T>
+[[gnu::always_inline]] inline void fog_corner_ray(const std::array<glm::vec3, 4>& corners, T u, T v, T (&ray)[3]) {
+  for (int k = 0; k < 3; ++k)
+    ray[k] = fog_bilerp(T(corners[kBottomLeft][k]), T(corners[kBottomRight][k]), T(corners[kTopLeft][k]),
+                        T(corners[kTopRight][k]), u, v);
+}
+
+// The ray term of a pixel (fog_ray_term: |ray(u, v)|, or its square where `squared`).
 template <class T>
 [[gnu::always_inline]] inline T fog_corner_ray_term(const std::array<glm::vec3, 4>& corners, T u, T v,
                                                     int squared) {
   T ray[3];
-  for (int k = 0; k < 3; ++k)
-    ray[k] = fog_bilerp(T(corners[kBottomLeft][k]), T(corners[kBottomRight][k]), T(corners[kTopLeft][k]),
-                        T(corners[kTopRight][k]), u, v);
+  fog_corner_ray(corners, u, v, ray);
   return fog_ray_term(ray[0], ray[1], ray[2], squared);
 }
 

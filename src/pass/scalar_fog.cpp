@@ -82,11 +82,8 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
       if (height) {
-        const T u = fog_pixel_u(T(x), inv_width);
         T ray[3];
-        for (int k = 0; k < 3; ++k)
-          ray[k] = fog_bilerp(T(cn[kBottomLeft][k]), T(cn[kBottomRight][k]), T(cn[kTopLeft][k]), T(cn[kTopRight][k]),
-                              u, vv);
+        fog_corner_ray(cn, fog_pixel_u(T(x), inv_width), vv, ray);
         int sky;
         T wy, d0, q_sun;
         const T s_hit = fog_height_geometry(T(raw_depth[i]), ray[0], ray[1], ray[2], kind, reversed, projection, zx, zy,
