@@ -427,14 +427,6 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_poly)(FOG_REAL x) {
   FOG_REAL e = ((FOG_REAL)1 + em) * FOG_NAME(fog_pow2i)(n1) * FOG_NAME(fog_pow2i)(n - n1);
   return x > (FOG_REAL)0x1.62e42ep+6f ? (FOG_REAL)INFINITY : (x < (FOG_REAL)-103.972f ? (FOG_REAL)0 : e);
 }
-/* e^x - 1 for x <= 0 (height fog's only arguments): relative error about 1 ulp, exactly -1 from
- * x = -30 on (the true value rounds to it from -17.4); NaN never comes in. */
-FOG_FN_INLINE FOG_REAL FOG_NAME(fog_expm1_neg_poly)(FOG_REAL x) {
-  FOG_REAL n;
-  FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(fmax(x, (FOG_REAL)-30.0f), &n));
-  FOG_REAL s = FOG_NAME(fog_pow2i)(n);
-  return fma(s, em, s - (FOG_REAL)1); /* n = 0: em itself */
-}
 /* log(1 + y) for -1 < y <= 0 (the sun lobe's log(cos θ) from y = -(1 - cos θ)): u = 1 + y,
  * log1p(y) = log(u) y / (u - 1) (exact in u - 1, Goldberg's correction of u's rounding), log(u) from
  * u = m 2^k, m in [sqrt(1/2), sqrt(2)), log(m) = 2 atanh(s), s = (m - 1) / (m + 1), to s^9. */
@@ -457,14 +449,22 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_log1p_neg_poly)(FOG_REAL y) {
   return u == (FOG_REAL)1 ? y : log_u * (y / (u - (FOG_REAL)1));
 }
 /* e^x and e^x - 1 of one x <= 0 from one reduction (T and J where beta_in == beta_ext): e^x is
- * 2^n (1 + em), exactly what fog_exp_poly gives but below 2^-126 (0 here); e^x - 1 as
- * fog_expm1_neg_poly. Returns e^x, writes e^x - 1. */
+ * 2^n (1 + em), exactly what fog_exp_poly gives but below 2^-126 (0 here). e^x - 1: relative
+ * error about 1 ulp, exactly -1 from x = -30 on (the true value rounds to it from -17.4; s - 1 is
+ * -1 once s < 2^-25); NaN never comes in. Returns e^x, writes e^x - 1. */
 FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_expm1_neg_poly)(FOG_REAL x, FOG_REAL* expm1_x) {
   FOG_REAL n;
   FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(fmax(x, (FOG_REAL)-87.0f), &n));
   FOG_REAL s = FOG_NAME(fog_pow2i)(n);
-  *expm1_x = fma(s, em, s - (FOG_REAL)1);
+  *expm1_x = fma(s, em, s - (FOG_REAL)1); /* n = 0: em itself */
   return x < (FOG_REAL)-87.0f ? (FOG_REAL)0 : fma(s, em, s);
+}
+/* e^x - 1 for x <= 0 (height fog's only arguments): fog_exp_expm1_neg_poly's, whose e^x then
+ * folds away. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_expm1_neg_poly)(FOG_REAL x) {
+  FOG_REAL expm1_x;
+  FOG_NAME(fog_exp_expm1_neg_poly)(x, &expm1_x);
+  return expm1_x;
 }
 #ifdef __OPENCL_C_VERSION__
 #ifndef FOG_EXP
