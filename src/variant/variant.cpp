@@ -10,6 +10,25 @@
 
 namespace fogcl {
 
+namespace {
+// Each HeightFeature's build option (FOG_HEIGHT_<option>) and its name in describe(), in bit order.
+struct HeightFeatureName {
+  int bit;
+  const char* option;
+  const char* label;
+};
+constexpr HeightFeatureName kHeightFeatureNames[] = {
+    {kHeightFalloff, "FALLOFF", "falloff"},
+    {kHeightRgb, "RGB", "rgb"},
+    {kHeightStart, "START", "start"},
+    {kHeightCutoff, "CUTOFF", "cutoff"},
+    {kHeightMaxOpacity, "MAX_OPACITY", "max-opacity"},
+    {kHeightSun, "SUN", "sun"},
+    {kHeightSunStart, "SUN_START", "sun-start"},
+    {kHeightSameIn, "SAME_IN", "same-in"},
+};
+}  // namespace
+
 Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFormat storage) {
   validate(s);
   Variant v;
@@ -48,23 +67,18 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
         if (h.sun->start > h.start) f |= kHeightSunStart;
       }
       v.height_features = f;
-      // Always along the ray from the eye; the sky is an infinite ray (§6.2), never at the far plane,
-      // fogged with fog_skybox (which SkyDistance::infinite implies, as in the other modes).
-      v.projection = camera.projection;
-      v.fog_skybox = s.fog_skybox || s.sky == SkyDistance::infinite;
-      v.reversed_z = camera.reversed_z;
-      v.depth_kind = camera.depth_kind;
-      v.storage = storage;
-      v.precision = s.precision;
-      return v;
+      break;
     }
   }
+  const bool height = v.mode == KernelMode::height;
   // Orthographic rays are parallel to the view axis: distance-based fog is depth-based fog, so
-  // the variant carries no ray interpolation and no sqrt for it.
+  // the variant carries no ray interpolation and no sqrt for it. Height fog is always along the
+  // ray from the eye, and its sky an infinite ray (§6.2), never at the far plane: fogged with
+  // fog_skybox, which SkyDistance::infinite implies in every mode.
   v.projection = camera.projection;
-  v.distance = s.metric == FogMetric::distance && camera.projection != Projection::orthographic;
-  v.sky_infinite = s.sky == SkyDistance::infinite;
-  v.fog_skybox = s.fog_skybox || v.sky_infinite;
+  v.distance = !height && s.metric == FogMetric::distance && camera.projection != Projection::orthographic;
+  v.sky_infinite = !height && s.sky == SkyDistance::infinite;
+  v.fog_skybox = s.fog_skybox || s.sky == SkyDistance::infinite;
   v.reversed_z = camera.reversed_z;
   v.depth_kind = camera.depth_kind;
   v.storage = storage;
@@ -131,12 +145,9 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.projection != Projection::perspective) o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
   if (v.precision == Precision::fast) o += " -D FOG_NATIVE_MATH -cl-fast-relaxed-math";
-  if (v.mode == KernelMode::height) {
-    static const char* const kNames[] = {"FALLOFF", "RGB", "START", "CUTOFF", "MAX_OPACITY", "SUN", "SUN_START", "",
-                                         "SAME_IN"};
-    for (int bit = 0; bit < 9; ++bit)
-      if (bit != 7 && (v.height_features & (1 << bit))) o += std::string(" -D FOG_HEIGHT_") + kNames[bit];
-  }
+  if (v.mode == KernelMode::height)
+    for (const HeightFeatureName& n : kHeightFeatureNames)
+      if (v.height_features & n.bit) o += std::string(" -D FOG_HEIGHT_") + n.option;
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device, v));
   o += streaming_store_option(device, v.storage);
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
@@ -159,10 +170,8 @@ std::string describe(const Variant& v) {
   if (!v.needs_pass()) return "none (no pass)";
   std::string d = to_string(v.mode);
   if (v.mode == KernelMode::height) {
-    static const char* const kNames[] = {" falloff", " rgb", " start", " cutoff", " max-opacity", " sun",
-                                         " sun-start", "", " same-in"};
-    for (int bit = 0; bit < 9; ++bit)
-      if (v.height_features & (1 << bit)) d += kNames[bit];
+    for (const HeightFeatureName& n : kHeightFeatureNames)
+      if (v.height_features & n.bit) d += std::string(" ") + n.label;
     if (!(v.height_features & kHeightFalloff)) d += " no-falloff";
     if (!(v.height_features & kHeightRgb)) d += " grey";
   } else {
