@@ -192,7 +192,7 @@ cl_event FogPass::Impl::dispatch(const cl::CommandQueue& queue, const FrameBuffe
     kernel->setArg(18, f4(h.up[0], h.up[1], h.up[2], 0.0f));
     kernel->setArg(19, f4(h.light[0], h.light[1], h.light[2], 0.0f));
   }
-  const int per_item = pixels_per_work_item(traits, v);
+  const int per_item = pixels_per_work_item(traits);
   queue.enqueueNDRangeKernel(*kernel, cl::NullRange, cl::NDRange((fb.width + per_item - 1) / per_item, fb.height),
                              cl::NullRange, waits, &done);
   ++stats.kernel_dispatches;

@@ -96,7 +96,6 @@ DeviceTraits device_traits(cl_device_id device, const CpuCodegen& codegen) {
 }
 
 int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }
-int pixels_per_work_item(const DeviceTraits& device, const Variant&) { return pixels_per_work_item(device); }
 
 long long streaming_min_pixels(const DeviceTraits& device) {
   if (!device.cpu) return -1;  // GPUs: one pixel per work-item, their own store paths
@@ -148,7 +147,7 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
   if (v.mode == KernelMode::height)
     for (const HeightFeatureName& n : kHeightFeatureNames)
       if (v.height_features & n.bit) o += std::string(" -D FOG_HEIGHT_") + n.option;
-  o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device, v));
+  o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
   o += streaming_store_option(device, v.storage);
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;

@@ -98,11 +98,9 @@ long long streaming_min_pixels(const DeviceTraits& device);
 // both passes' CPU kernels take (kernels/fog_cpu_avx512.h, FOG_STREAMS).
 std::string streaming_store_option(const DeviceTraits& device, ColorFormat storage);
 
-// Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere.
+// Pixels each work-item fogs: 16 (one SIMD vector of pixels) on CPU devices, 1 elsewhere, in
+// every mode (height fog too: its formulas run on 16 lanes like the others').
 int pixels_per_work_item(const DeviceTraits& device);
-// Pixels each work-item of `variant` fogs: as above for every mode (height fog too: its formulas
-// run on 16 lanes like the others').
-int pixels_per_work_item(const DeviceTraits& device, const Variant& variant);
 
 // "-cl-std=CL1.2 -D FOG_MODE=4 -D FOG_DISTANCE ... -D FOG_VECTOR_WIDTH=16". Deterministic: equal
 // inputs give equal strings, so the string is the program cache key.
