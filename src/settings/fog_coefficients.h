@@ -50,6 +50,13 @@ FogCoefficients<T> fog_coefficients(const FogSettings& s, KernelMode mode) {
   return c;
 }
 
+// Height fog's coefficients per channel (docs/DESIGN.md §6.1): the extinction beta_ext (unset: the
+// density in every channel) and the in-scattering beta_in (unset: the extinction).
+inline glm::vec3 height_extinction(const FogSettings& s) { return s.height.extinction.value_or(glm::vec3(s.density)); }
+inline glm::vec3 height_inscattering(const FogSettings& s) {
+  return s.height.inscattering.value_or(height_extinction(s));
+}
+
 // The per-frame constants of height fog (docs/DESIGN.md §6) in T: the FOG_HP_* block of
 // kernels/fog_math.h, and the camera in view space, so that a pixel needs no rotation: ω.y =
 // dot(ω_view, up) and cos(ω, ℓ) from ω_view and light. The rotation is computed in double and
@@ -66,8 +73,7 @@ template <class T>
 HeightCoefficients<T> height_coefficients(const FogSettings& s, const CameraParams& cam) {
   HeightCoefficients<T> c;
   const HeightFogSettings& h = s.height;
-  const glm::vec3 ext = h.extinction.value_or(glm::vec3(s.density));
-  const glm::vec3 in = h.inscattering.value_or(ext);
+  const glm::vec3 ext = height_extinction(s), in = height_inscattering(s);
   c.p[FOG_HP_K] = T(h.falloff);
   c.p[FOG_HP_START] = T(h.start);
   c.p[FOG_HP_CUTOFF] = T(h.cutoff);

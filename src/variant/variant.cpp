@@ -7,6 +7,7 @@
 #include "fogcl/error.h"
 #include "fogcl/runtime.h"
 #include "fogcl/volumes.h"
+#include "settings/fog_coefficients.h"
 
 namespace fogcl {
 
@@ -49,8 +50,7 @@ Variant select_variant(const FogSettings& s, const CameraParams& camera, ColorFo
         throw Error("height fog needs the camera pose (CameraParams::pose: eye, forward, up)");
       validate(*camera.pose);
       const HeightFogSettings& h = s.height;
-      const glm::vec3 ext = h.extinction.value_or(glm::vec3(s.density));
-      const glm::vec3 in = h.inscattering.value_or(ext);
+      const glm::vec3 ext = detail::height_extinction(s), in = detail::height_inscattering(s);
       // Maximum opacity 0, or no extinction and no in-scattering: T = 1 and J = 0 everywhere (the
       // lobe scales J_sun, also 0): no pass, output = input bit for bit.
       if (h.max_opacity == 0.0f || (ext == glm::vec3(0.0f) && in == glm::vec3(0.0f))) return v;
