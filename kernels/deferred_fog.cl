@@ -165,26 +165,45 @@ typedef struct {
 #endif
 } FogConstants;
 
-/* Blends one pixel (index i in the frame; color RGBA at 4 * i) with its fog factor f. */
+/* One pixel (index i in the frame; color RGBA at 4 * i) as one vector load and store: GPUs, and
+ * CPU devices' row tails. */
+static inline float4 fog_load_pixel(global const COLOR_T* color, size_t i) {
+#ifdef FOG_COLOR_HALF
+  return vload_half4(i, color);
+#else
+  return vload4(i, color);
+#endif
+}
+static inline void fog_store_pixel(float4 o, global COLOR_T* color, size_t i) {
+#ifdef FOG_COLOR_HALF
+  vstore_half4_rte(o, i, color);
+#else
+  vstore4(o, i, color);
+#endif
+}
+/* The pixel's bits unchanged: in half storage a half -> float -> half trip would quiet a
+ * signalling NaN. */
+static inline void fog_copy_pixel(global const COLOR_T* color_in, global COLOR_T* color_out, size_t i) {
+#ifdef FOG_COLOR_HALF
+  vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
+#else
+  vstore4(vload4(i, color_in), i, color_out);
+#endif
+}
+
+/* Blends one pixel with its fog factor f. */
 static inline void fog_blend_pixel(global const COLOR_T* color_in, global COLOR_T* color_out,
                                    size_t i, float f, const FogConstants* k) {
 #ifdef FOG_COLOR_HALF
   if (f == 1.0f) {
-    /* Copy the bits: a half -> float -> half trip would quiet a signalling NaN. */
-    vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
+    fog_copy_pixel(color_in, color_out, i);
     return;
   }
-  const float4 c = vload_half4(i, color_in);
-#else
-  const float4 c = vload4(i, color_in);
 #endif
+  const float4 c = fog_load_pixel(color_in, i);
   const float4 o = (float4)(fog_blend(c.x, k->fog_color.x, f), fog_blend(c.y, k->fog_color.y, f),
                             fog_blend(c.z, k->fog_color.z, f), c.w /* alpha passes through */);
-#ifdef FOG_COLOR_HALF
-  vstore_half4_rte(o, i, color_out);
-#else
-  vstore4(o, i, color_out);
-#endif
+  fog_store_pixel(o, color_out, i);
 }
 
 #if FOG_MODE == FOG_MODE_HEIGHT
@@ -200,28 +219,13 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
       fog_bilerp(k->bl.z, k->br.z, k->tl.z, k->tr.z, u, v), FOG_DEPTH_KIND, FOG_USE_REVERSED_Z, FOG_PROJECTION, k->zx,
       k->zy, k->near_plane, k->far_plane, k->up.x, k->up.y, k->up.z, k->light.x, k->light.y, k->light.z,
       FOG_HB_SUN != 0, k->d0, &sky, &wy, &d0, &q_sun);
-  /* GPUs (and CPU devices' row tails): the pixel as one vector load and store. */
-#ifdef FOG_COLOR_HALF
-  const float4 c = vload_half4(i, color_in);
-#else
-  const float4 c = vload4(i, color_in);
-#endif
+  const float4 c = fog_load_pixel(color_in, i);
   float rgb[3] = {c.x, c.y, c.z};
   if (!fog_height_pixel(rgb, s_hit, sky, wy, d0, q_sun, k->hp, FOG_HEIGHT_BITS)) {
-#ifdef FOG_COLOR_HALF
-    /* Copy the bits: a half -> float -> half trip would quiet a signalling NaN. */
-    vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
-#else
-    vstore4(c, i, color_out);
-#endif
+    fog_copy_pixel(color_in, color_out, i);
     return;
   }
-  const float4 o = (float4)(rgb[0], rgb[1], rgb[2], c.w /* alpha passes through */);
-#ifdef FOG_COLOR_HALF
-  vstore_half4_rte(o, i, color_out);
-#else
-  vstore4(o, i, color_out);
-#endif
+  fog_store_pixel((float4)(rgb[0], rgb[1], rgb[2], c.w /* alpha passes through */), color_out, i);
 }
 #else
 /* One pixel at column x, row y: the GPU path and the row tails of the CPU path. */
