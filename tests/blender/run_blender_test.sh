@@ -25,20 +25,10 @@ fi
 fogcl=$(readlink -f "$1")
 here=$(cd "$(dirname "$0")" && pwd)
 camera_script=$here/../../examples/blender_camera.py
-# shellcheck source=tests/support/apt.sh
-. "$here/../support/apt.sh"
+TEST_NAME="blender test" TEST_GATE=FOGCL_BLENDER_TEST
+# shellcheck source=tests/support/script_test.sh
+. "$here/../support/script_test.sh"
 started=$SECONDS
-
-say() { echo "blender test: $*"; }
-fail() {
-  echo "blender test: FAIL: $*" >&2
-  exit 1
-}
-skip_or_fail() {
-  if [ "${FOGCL_BLENDER_TEST:-}" = required ]; then fail "$* (FOGCL_BLENDER_TEST=required)"; fi
-  echo "blender test: SKIP: $*"
-  exit 77
-}
 
 # ---- Blender, installed where missing ------------------------------------------------------------
 if ! command -v blender > /dev/null; then

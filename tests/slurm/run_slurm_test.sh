@@ -30,19 +30,9 @@ fogcl=$(readlink -f "$1")
 make_sequence=$(readlink -f "$2")
 example=$(readlink -f "$3")
 started=$SECONDS
-# shellcheck source=tests/support/apt.sh
-. "$(cd "$(dirname "$0")" && pwd)/../support/apt.sh"
-
-say() { echo "slurm test: $*"; }
-fail() {
-  echo "slurm test: FAIL: $*" >&2
-  exit 1
-}
-skip_or_fail() {
-  if [ "${FOGCL_SLURM_TEST:-}" = required ]; then fail "$* (FOGCL_SLURM_TEST=required)"; fi
-  echo "slurm test: SKIP: $*"
-  exit 77
-}
+TEST_NAME="slurm test" TEST_GATE=FOGCL_SLURM_TEST
+# shellcheck source=tests/support/script_test.sh
+. "$(cd "$(dirname "$0")" && pwd)/../support/script_test.sh"
 
 [ "$(id -u)" -eq 0 ] || skip_or_fail "needs root (runs slurmd with SlurmUser root, installs slurm-wlm and munge)"
 

@@ -1,6 +1,20 @@
 # shellcheck shell=bash
-# Debian packages installed where a test needs them, for tests/*/run_*_test.sh (sourced; bash).
-# The caller defines say() (its progress line) and runs as root with apt-get present.
+# What tests/*/run_*_test.sh share (sourced; bash): their messages and exits, and the Debian
+# packages installed where a test needs them. The caller sets TEST_NAME ("blender test") and
+# TEST_GATE (the variable whose value `required` turns a skip into a failure) before sourcing,
+# and runs as root with apt-get present where it installs.
+
+say() { echo "$TEST_NAME: $*"; }
+fail() {
+  echo "$TEST_NAME: FAIL: $*" >&2
+  exit 1
+}
+# Exit 77 (ctest's skip), or fail where $TEST_GATE is `required`.
+skip_or_fail() {
+  if [ "${!TEST_GATE:-}" = required ]; then fail "$* ($TEST_GATE=required)"; fi
+  echo "$TEST_NAME: SKIP: $*"
+  exit 77
+}
 
 # apt_update_if_needed ON_ERROR PKG...: apt-get update only where a clean machine has no package
 # lists yet (no policy for the first package, or no candidate for one of them); ON_ERROR (the
