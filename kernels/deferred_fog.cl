@@ -142,6 +142,7 @@
 #define FOG_LANES16
 #ifdef FOG_AVX512
 #define FOG_CEIL fog_ceil_avx512
+#define FOG_FLOOR fog_floor_avx512
 #define FOG_EXP2_LDEXP fog_exp2_ldexp_avx512
 #endif
 #include "fog_math.h" /* the 16-pixel instance */
@@ -252,11 +253,10 @@ static inline void fog_pixel(global const COLOR_T* color_in, global const float*
 
 #if FOG_VECTOR_WIDTH == 16 && FOG_MODE == FOG_MODE_HEIGHT
 /* Height fog on 16 pixels of a row (CPU devices): the same formulas on float16 lanes, one pixel a
- * lane; the colors are split into R, G, B vectors and put back together by shuffles. Pixels that
- * pass through keep their bits (a select in float storage; copied back in half storage). */
-#define FOG_H_QUAD(q, a, b, c, d)                                                                     \
-  (float16)(rgb[0].s##a, rgb[1].s##a, rgb[2].s##a, q.s3, rgb[0].s##b, rgb[1].s##b, rgb[2].s##b, q.s7, \
-            rgb[0].s##c, rgb[1].s##c, rgb[2].s##c, q.sb, rgb[0].s##d, rgb[1].s##d, rgb[2].s##d, q.sf)
+ * lane. The four RGBA quads are split into R, G, B vectors and put back together by two-source
+ * permutes (FOG_SHUFFLE), 14 for the block: written as vector swizzles, LLVM assembled the same
+ * split from 32 eight-byte loads and some 70 inserts and permutes. Pixels that pass through keep
+ * their bits (a select in float storage; copied back in half storage). */
 static inline void fog_height_pixels16(global const COLOR_T* color_in, global const float* depth,
                                        global COLOR_T* color_out, size_t i0, int x0, int y,
                                        const FogConstants* k) {
@@ -276,29 +276,45 @@ static inline void fog_height_pixels16(global const COLOR_T* color_in, global co
   global COLOR_T* out = color_out + 4 * i0;
   const float16 q0 = fog_load_quad(in, 0), q1 = fog_load_quad(in, 1), q2 = fog_load_quad(in, 2),
                 q3 = fog_load_quad(in, 3);
-  float16 rgb[3] = {(float16)(q0.s048c, q1.s048c, q2.s048c, q3.s048c),
-                    (float16)(q0.s159d, q1.s159d, q2.s159d, q3.s159d),
-                    (float16)(q0.s26ae, q1.s26ae, q2.s26ae, q3.s26ae)};
+  /* Pixels 0-7 (from q0, q1) and 8-15 (q2, q3): R in lanes 0-7, G in 8-15; B in 0-7, A in 8-15. */
+#define FOG_H_SPLIT(a, b, c0, c1)                                                                  \
+  FOG_SHUFFLE(a, b, c0, c0 + 4, c0 + 8, c0 + 12, c0 + 16, c0 + 20, c0 + 24, c0 + 28, c1, c1 + 4, c1 + 8, \
+              c1 + 12, c1 + 16, c1 + 20, c1 + 24, c1 + 28)
+  const float16 rg_lo = FOG_H_SPLIT(q0, q1, 0, 1), ba_lo = FOG_H_SPLIT(q0, q1, 2, 3);
+  const float16 rg_hi = FOG_H_SPLIT(q2, q3, 0, 1), ba_hi = FOG_H_SPLIT(q2, q3, 2, 3);
+#undef FOG_H_SPLIT
+  float16 rgb[3] = {FOG_SHUFFLE(rg_lo, rg_hi, 0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23),
+                    FOG_SHUFFLE(rg_lo, rg_hi, 8, 9, 10, 11, 12, 13, 14, 15, 24, 25, 26, 27, 28, 29, 30, 31),
+                    FOG_SHUFFLE(ba_lo, ba_hi, 0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23)};
   const int16 fogged = fog_height_pixel_v(rgb, s_hit, sky, wy, d0, q_sun, k->hp, FOG_HEIGHT_BITS);
   /* Lanes passed through: bit j set where pixel j is not fogged. */
   const uint keep = fog_lanes_equal(as_float16(fogged & as_int16((float16)1.0f)), 0.0f);
   global const uint* in_bits = (global const uint*)in;
   global uint* out_bits = (global uint*)out;
   if (keep == 0xffffu) {
-    for (uint w = 0; w < 16 * sizeof(COLOR_T); ++w) out_bits[w] = in_bits[w];
+    fog_copy_block(in_bits, out_bits, k);
     return;
   }
-  fog_store_quad(FOG_H_QUAD(q0, 0, 1, 2, 3), out, 0, k);
-  fog_store_quad(FOG_H_QUAD(q1, 4, 5, 6, 7), out, 1, k);
-  fog_store_quad(FOG_H_QUAD(q2, 8, 9, a, b), out, 2, k);
-  fog_store_quad(FOG_H_QUAD(q3, c, d, e, f), out, 3, k);
+  /* Back to quads: R and G of pixels 0-7 interleaved (rg0), B and A (ba0), then pixels 8-15; the
+   * alpha lanes are the input's. */
+  const float16 rg0 = FOG_SHUFFLE(rgb[0], rgb[1], 0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23);
+  const float16 rg1 = FOG_SHUFFLE(rgb[0], rgb[1], 8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+  const float16 ba0 = FOG_SHUFFLE(rgb[2], ba_lo, 0, 24, 1, 25, 2, 26, 3, 27, 4, 28, 5, 29, 6, 30, 7, 31);
+  const float16 ba1 = FOG_SHUFFLE(rgb[2], ba_hi, 8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31);
+#define FOG_H_MERGE(rg, ba, p)                                                                     \
+  FOG_SHUFFLE(rg, ba, p, p + 1, p + 16, p + 17, p + 2, p + 3, p + 18, p + 19, p + 4, p + 5, p + 20, \
+              p + 21, p + 6, p + 7, p + 22, p + 23)
+  fog_store_quad(FOG_H_MERGE(rg0, ba0, 0), out, 0, k);
+  fog_store_quad(FOG_H_MERGE(rg0, ba0, 8), out, 1, k);
+  fog_store_quad(FOG_H_MERGE(rg1, ba1, 0), out, 2, k);
+  fog_store_quad(FOG_H_MERGE(rg1, ba1, 8), out, 3, k);
+#undef FOG_H_MERGE
 #ifdef FOG_COLOR_HALF
   if (keep != 0)
     for (uint j = 0; j < 16; ++j)
       if (keep & (1u << j)) vstore2(vload2(j, in_bits), j, out_bits);
 #endif
 }
-#undef FOG_H_QUAD
 #define fog_pixels16 fog_height_pixels16
 #endif
 

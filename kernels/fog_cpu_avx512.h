@@ -59,6 +59,13 @@ static inline float16 fog_ceil_avx512(float16 x) {
       (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
 }
 
+/* Lanes rounded down to an integer: one vrndscaleps (PoCL's floor is a 12-instruction routine). */
+static inline float16 fog_floor_avx512(float16 x) {
+  return __builtin_bit_cast(float16, __builtin_ia32_rndscaleps_mask(
+      __builtin_bit_cast(fog_v16f, x), 0x09 /* round down, no precision exception */,
+      (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
+}
+
 /* p * 2^n where x >= -126, else 0: one vscalefps under a zero mask. n is an integer in
  * [-126, 0] wherever x >= -126, so p * 2^n is exact there, as the portable path's multiply by the
  * bits of 2^n is; the masked lanes may hold anything (x = -inf makes them NaN). */

@@ -55,6 +55,14 @@ static inline void fog_store_quad(float16 value, global COLOR_T* p, uint q, cons
 #endif
 }
 
+/* A block's 16 pixels copied bit for bit (as 32-bit words: rows need not start at a 64-byte
+ * boundary). */
+static inline void fog_copy_block(global const uint* in_bits, global uint* out_bits, const FogConstants* k) {
+  for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16)
+    FOG_STREAM_OR(__builtin_bit_cast(uint16, *(global const fog_v16u_u*)(in_bits + w)), out_bits + w, k->stream,
+                  FOG_COPY16(in_bits + w, out_bits + w));
+}
+
 /* Pixel j's factor in its R, G, B lanes and 1 in its alpha lane (q: pixels 4q..4q+3, a literal),
  * which makes fog_blend pass alpha through. */
 #define FOG_QUAD_FACTORS(f, q)                                                                     \
@@ -94,9 +102,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   global uint* out_bits = (global uint*)out;
   const uint keep = fog_lanes_equal(f, 1.0f);
   if (keep == 0xffffu) {
-    for (uint w = 0; w < 16 * sizeof(COLOR_T); w += 16)
-      FOG_STREAM_OR(__builtin_bit_cast(uint16, *(global const fog_v16u_u*)(in_bits + w)), out_bits + w, k->stream,
-                    FOG_COPY16(in_bits + w, out_bits + w));
+    fog_copy_block(in_bits, out_bits, k);
     return;
   }
   const float16 fog_rgba = (float16)(k->fog_color.xyz, 0.0f, k->fog_color.xyz, 0.0f,

@@ -7,7 +7,7 @@
  *     same text runs in float for the baseline and in double for the reference.
  * In OpenCL C this file defines the instance's macros itself (below): the one-pixel instance, or
  * the 16-pixel one when the includer defines FOG_LANES16; the includer defines FOG_EXP2 and may
- * define the optional hooks FOG_CEIL and FOG_EXP2_LDEXP. In C++ the includer defines FOG_INT,
+ * define the optional hooks FOG_CEIL, FOG_FLOOR and FOG_EXP2_LDEXP. In C++ the includer defines FOG_INT,
  * FOG_NAME, FOG_TRUNC_INT, FOG_TO_REAL and FOG_AS_REAL. This file has no include guard on purpose
  * and undefines the instance macros (not FOG_EXP2) at its end. Only operations that exist in both languages
  * appear: + - * /, fma, expm1, sqrt, fmin, fmax, integer + and <<, a float -> int conversion, and
@@ -410,9 +410,14 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_expm1_reduced)(FOG_REAL r) {
   p = fma(p, r, (FOG_REAL)0.5f);
   return fma(r * r, p, r);
 }
+/* floor, or the includer's FOG_FLOOR giving the same bits (PoCL's floor is a 12-instruction
+ * routine; on AVX-512 one vrndscaleps). */
+#ifndef FOG_FLOOR
+#define FOG_FLOOR floor
+#endif
 /* x = n ln2 + r, |r| <= ln2/2: n = floor(x log2(e) + 1/2), r with ln2 in two parts (Cody-Waite). */
 FOG_FN_INLINE FOG_REAL FOG_NAME(fog_ln2_reduce)(FOG_REAL x, FOG_REAL* n) {
-  *n = floor(fma(x, (FOG_REAL)0x1.715476p+0f, (FOG_REAL)0.5f));
+  *n = FOG_FLOOR(fma(x, (FOG_REAL)0x1.715476p+0f, (FOG_REAL)0.5f));
   return fma(-*n, (FOG_REAL)0x1.7f7d1cp-20f, fma(-*n, (FOG_REAL)0x1.62e4p-1f, x));
 }
 /* 2^n for an integral n in [-126, 127]. */
@@ -423,7 +428,7 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_poly)(FOG_REAL x) {
   FOG_REAL xc = fmin(fmax(x, (FOG_REAL)-104.0f), (FOG_REAL)89.0f), n;
   FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(xc, &n));
   /* 2^n in two factors: n in [-150, 129] has no single float scale. */
-  FOG_REAL n1 = floor(n * (FOG_REAL)0.5f);
+  FOG_REAL n1 = FOG_FLOOR(n * (FOG_REAL)0.5f);
   FOG_REAL e = ((FOG_REAL)1 + em) * FOG_NAME(fog_pow2i)(n1) * FOG_NAME(fog_pow2i)(n - n1);
   return x > (FOG_REAL)0x1.62e42ep+6f ? (FOG_REAL)INFINITY : (x < (FOG_REAL)-103.972f ? (FOG_REAL)0 : e);
 }
@@ -475,12 +480,6 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_expm1_neg_poly)(FOG_REAL x) {
 #endif
 #endif
 
-/* G(a) = (1 - e^-a) / a for a >= 0, G(0) = 1 by a select: expm1 keeps every digit of tiny a, so
- * no series branch is needed (Unreal's switches to a Taylor series below |x| = 0.01). */
-FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_g)(FOG_REAL a) {
-  return a == (FOG_REAL)0 ? (FOG_REAL)1 : -FOG_EXPM1(-a) / a;
-}
-
 /* H = integral over [s0, s1] of e^(-k (h(s) - b)) ds along a ray whose height above the base is
  * d0 + s * wy (wy = ω.y, d0 = origin height - b). H = L e^(-k (h* - b)) G(|x|), x = k wy L (the
  * height change times k, from the direction, never a difference of heights, which cancels), h*
@@ -495,9 +494,16 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_length)(FOG_REAL s0, FOG_REAL s1, FOG
   FOG_REAL x = kwy * L;
   FOG_REAL e0 = fma(s0, wy, d0); /* h0 - b */
   FOG_REAL e1 = fma(s1, wy, d0); /* h1 - b */
-  FOG_REAL top = x >= (FOG_REAL)0 ? e0 : e1;
-  FOG_REAL h = L * FOG_EXP(-k * top) * FOG_NAME(fog_height_g)(fabs(x));
-  FOG_REAL h_inf = kwy > (FOG_REAL)0 ? FOG_EXP(-k * e0) / kwy : (FOG_REAL)INFINITY;
+  /* The infinite ray rises (or is +inf) from h0: its exponential is e0's too, so the sky and the
+   * surface share one exponential and one division. */
+  FOG_REAL top = (sky_infinite | (x >= (FOG_REAL)0)) ? e0 : e1;
+  FOG_REAL e = FOG_EXP(-k * top);
+  /* G(a) = (1 - e^-a) / a for a = |x| >= 0, G(0) = 1 by a select: expm1 keeps every digit of tiny
+   * a, so no series branch is needed (Unreal's switches to a Taylor series below |x| = 0.01). */
+  FOG_REAL a = fabs(x);
+  FOG_REAL q = (sky_infinite ? e : -FOG_EXPM1(-a)) / (sky_infinite ? kwy : a);
+  FOG_REAL h = L * e * (a == (FOG_REAL)0 ? (FOG_REAL)1 : q);
+  FOG_REAL h_inf = kwy > (FOG_REAL)0 ? q : (FOG_REAL)INFINITY;
   return sky_infinite ? h_inf : h;
 }
 
@@ -526,6 +532,35 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_blend)(FOG_REAL c, FOG_REAL t, FOG_RE
   return t == (FOG_REAL)0 ? added : fma(c, t, added);
 }
 
+/* Channel c's transmittance T, in-scattered fraction J and the sun's J_sun (docs/DESIGN.md §6.2)
+ * from H and H_sun, capped by the maximum opacity where the variant has one. */
+FOG_FN_INLINE void FOG_NAME(fog_height_tj)(FOG_REAL h, FOG_REAL h_sun, const FOG_HP_T* p, int c, int features,
+                                           FOG_REAL* t, FOG_REAL* j, FOG_REAL* j_sun) {
+  if (features & FOG_HF_SAME_IN) {
+    *t = FOG_EXP_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h), j);
+    *j = -*j;
+  } else {
+    *t = FOG_EXP(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h));
+    *j = -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h));
+  }
+  *j_sun = (features & FOG_HF_SUN_START) ? -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h_sun))
+                                         : *j;
+  if (features & FOG_HF_MAX_OPACITY) {
+    *t = fmax(*t, (FOG_REAL)p[FOG_HP_MIN_T]);
+    *j = fmin(*j, (FOG_REAL)p[FOG_HP_MAX]);
+    *j_sun = fmin(*j_sun, (FOG_REAL)p[FOG_HP_MAX]);
+  }
+}
+
+/* Channel c of a pixel's output: its color where the pixel is not fogged, bit for bit. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_out)(FOG_REAL color, FOG_REAL t, FOG_REAL j, FOG_REAL j_sun,
+                                                FOG_REAL lobe, FOG_INT fogged, const FOG_HP_T* p, int c,
+                                                int features) {
+  FOG_REAL sun = (features & FOG_HF_SUN) ? (FOG_REAL)p[FOG_HP_SUN + c] * lobe * j_sun : (FOG_REAL)0;
+  FOG_REAL fogged_c = FOG_NAME(fog_height_blend)(color, t, (FOG_REAL)p[FOG_HP_FOG + c], j, sun);
+  return fogged ? fogged_c : color;
+}
+
 /* The height fog of one pixel (docs/DESIGN.md §6.2) into rgb[0..2]. s_hit: distance along the ray
  * to the surface (fog_view_distance's distance-based metric), sky: the pixel is sky, wy: ω.y,
  * d0: the ray origin's height - b, q_sun: 1 - cos(ω, ℓ) (read with FOG_HF_SUN), p: FOG_HP_*
@@ -534,7 +569,6 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_blend)(FOG_REAL c, FOG_REAL t, FOG_RE
  * H_sun = 0). Branch-free on the pixel's values (selects), so that it runs on 16 lanes too. */
 FOG_FN_INLINE FOG_INT FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, FOG_INT sky, FOG_REAL wy,
                                                 FOG_REAL d0, FOG_REAL q_sun, const FOG_HP_T* p, int features) {
-  const int rgb_channels = (features & FOG_HF_RGB) ? 3 : 1;
   const int falloff = (features & FOG_HF_FALLOFF) != 0;
   FOG_REAL s0 = (features & FOG_HF_START) ? (FOG_REAL)p[FOG_HP_START] : (FOG_REAL)0;
   FOG_REAL s1 = (features & FOG_HF_CUTOFF) ? fmin(s_hit, (FOG_REAL)p[FOG_HP_CUTOFF]) : s_hit;
@@ -559,30 +593,21 @@ FOG_FN_INLINE FOG_INT FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, 
     }
   }
   FOG_INT fogged = !pass & !((h == (FOG_REAL)0) & (h_sun == (FOG_REAL)0));
+  /* Channel by channel in straight-line code: a loop over them kept the 16-lane instance's colors
+   * in memory (PoCL left it rolled). */
   FOG_REAL t[3], j[3], j_sun[3];
-  for (int c = 0; c < rgb_channels; ++c) {
-    if (features & FOG_HF_SAME_IN) {
-      t[c] = FOG_EXP_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h), &j[c]);
-      j[c] = -j[c];
-    } else {
-      t[c] = FOG_EXP(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h));
-      j[c] = -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h));
-    }
-    j_sun[c] = (features & FOG_HF_SUN_START)
-                   ? -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h_sun))
-                   : j[c];
-    if (features & FOG_HF_MAX_OPACITY) {
-      t[c] = fmax(t[c], (FOG_REAL)p[FOG_HP_MIN_T]);
-      j[c] = fmin(j[c], (FOG_REAL)p[FOG_HP_MAX]);
-      j_sun[c] = fmin(j_sun[c], (FOG_REAL)p[FOG_HP_MAX]);
-    }
+  FOG_NAME(fog_height_tj)(h, h_sun, p, 0, features, &t[0], &j[0], &j_sun[0]);
+  if (features & FOG_HF_RGB) {
+    FOG_NAME(fog_height_tj)(h, h_sun, p, 1, features, &t[1], &j[1], &j_sun[1]);
+    FOG_NAME(fog_height_tj)(h, h_sun, p, 2, features, &t[2], &j[2], &j_sun[2]);
+  } else {
+    t[1] = t[2] = t[0];
+    j[1] = j[2] = j[0];
+    j_sun[1] = j_sun[2] = j_sun[0];
   }
-  for (int c = 0; c < 3; ++c) {
-    const int i = rgb_channels == 3 ? c : 0;
-    FOG_REAL sun = (features & FOG_HF_SUN) ? (FOG_REAL)p[FOG_HP_SUN + c] * lobe * j_sun[i] : (FOG_REAL)0;
-    FOG_REAL fogged_c = FOG_NAME(fog_height_blend)(rgb[c], t[i], (FOG_REAL)p[FOG_HP_FOG + c], j[i], sun);
-    rgb[c] = fogged ? fogged_c : rgb[c];
-  }
+  rgb[0] = FOG_NAME(fog_height_out)(rgb[0], t[0], j[0], j_sun[0], lobe, fogged, p, 0, features);
+  rgb[1] = FOG_NAME(fog_height_out)(rgb[1], t[1], j[1], j_sun[1], lobe, fogged, p, 1, features);
+  rgb[2] = FOG_NAME(fog_height_out)(rgb[2], t[2], j[2], j_sun[2], lobe, fogged, p, 2, features);
   return fogged;
 }
 /* Height fog's geometry of a pixel (docs/DESIGN.md §6.1), in view space: no rotation per pixel.
@@ -626,6 +651,7 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_geometry)(FOG_REAL raw, FOG_REAL cx, 
 #undef FOG_AS_REAL
 #undef FOG_AS_INT
 #undef FOG_CEIL
+#undef FOG_FLOOR
 #undef FOG_EXP2_LDEXP
 #undef FOG_NAME
 #undef FOG_LANES16
