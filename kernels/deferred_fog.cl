@@ -143,6 +143,7 @@
 #ifdef FOG_AVX512
 #define FOG_CEIL fog_ceil_avx512
 #define FOG_FLOOR fog_floor_avx512
+#define FOG_SCALE2 fog_scale2_avx512
 #define FOG_EXP2_LDEXP fog_exp2_ldexp_avx512
 #endif
 #include "fog_math.h" /* the 16-pixel instance */

@@ -66,6 +66,14 @@ static inline float16 fog_floor_avx512(float16 x) {
       (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
 }
 
+/* p * 2^n for an integral n, rounded once: one vscalefps (height fog's e^x, whose n reaches -150
+ * and 129, needs two multiplies otherwise). */
+static inline float16 fog_scale2_avx512(float16 p, float16 n) {
+  return __builtin_bit_cast(float16, __builtin_ia32_scalefps512_mask(
+      __builtin_bit_cast(fog_v16f, p), __builtin_bit_cast(fog_v16f, n), (fog_v16f){}, (ushort)0xffff,
+      4 /* current rounding */));
+}
+
 /* p * 2^n where x >= -126, else 0: one vscalefps under a zero mask. n is an integer in
  * [-126, 0] wherever x >= -126, so p * 2^n is exact there, as the portable path's multiply by the
  * bits of 2^n is; the masked lanes may hold anything (x = -inf makes them NaN). */

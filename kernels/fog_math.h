@@ -7,7 +7,7 @@
  *     same text runs in float for the baseline and in double for the reference.
  * In OpenCL C this file defines the instance's macros itself (below): the one-pixel instance, or
  * the 16-pixel one when the includer defines FOG_LANES16; the includer defines FOG_EXP2 and may
- * define the optional hooks FOG_CEIL, FOG_FLOOR and FOG_EXP2_LDEXP. In C++ the includer defines FOG_INT,
+ * define the optional hooks FOG_CEIL, FOG_FLOOR, FOG_SCALE2 (p 2^n, one rounding) and FOG_EXP2_LDEXP. In C++ the includer defines FOG_INT,
  * FOG_NAME, FOG_TRUNC_INT, FOG_TO_REAL and FOG_AS_REAL. This file has no include guard on purpose
  * and undefines the instance macros (not FOG_EXP2) at its end. Only operations that exist in both languages
  * appear: + - * /, fma, expm1, sqrt, fmin, fmax, integer + and <<, a float -> int conversion, and
@@ -427,9 +427,14 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_pow2i)(FOG_REAL n) { return FOG_AS_REAL((FOG
 FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_poly)(FOG_REAL x) {
   FOG_REAL xc = fmin(fmax(x, (FOG_REAL)-104.0f), (FOG_REAL)89.0f), n;
   FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(xc, &n));
-  /* 2^n in two factors: n in [-150, 129] has no single float scale. */
+#ifdef FOG_SCALE2
+  FOG_REAL e = FOG_SCALE2((FOG_REAL)1 + em, n);
+#else
+  /* 2^n in two factors: n in [-150, 129] has no single float scale. The first product is exact
+   * (normal), so the result is rounded once, as FOG_SCALE2's is. */
   FOG_REAL n1 = FOG_FLOOR(n * (FOG_REAL)0.5f);
   FOG_REAL e = ((FOG_REAL)1 + em) * FOG_NAME(fog_pow2i)(n1) * FOG_NAME(fog_pow2i)(n - n1);
+#endif
   return x > (FOG_REAL)0x1.62e42ep+6f ? (FOG_REAL)INFINITY : (x < (FOG_REAL)-103.972f ? (FOG_REAL)0 : e);
 }
 /* log(1 + y) for -1 < y <= 0 (the sun lobe's log(cos θ) from y = -(1 - cos θ)): u = 1 + y,
@@ -652,6 +657,7 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_geometry)(FOG_REAL raw, FOG_REAL cx, 
 #undef FOG_AS_INT
 #undef FOG_CEIL
 #undef FOG_FLOOR
+#undef FOG_SCALE2
 #undef FOG_EXP2_LDEXP
 #undef FOG_NAME
 #undef FOG_LANES16

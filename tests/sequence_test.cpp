@@ -488,7 +488,7 @@ TEST_F(Sequence, BadOutputChoicesNameTheValueAndWriteNothing) {
     const char* expect;
   } cases[] = {
       {" --pixel-type double", "--pixel-type must be half or float (got 'double')"},
-      {" --compression lzma", "--compression must be one of none, rle, zips, zip, piz, pxr24, b44, dwaa, dwab (got 'lzma')"},
+      {" --compression lzma", "--compression must be one of none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa, dwab (got 'lzma')"},
       {" --compression ZIP", "(got 'ZIP')"},
       {" --threads 0", "--threads must be between 1 and 4096 (got 0)"},
       {" --threads 5000", "--threads must be between 1 and 4096 (got 5000)"},
@@ -500,7 +500,7 @@ TEST_F(Sequence, BadOutputChoicesNameTheValueAndWriteNothing) {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
     EXPECT_TRUE(out_files().empty()) << c.args;
   }
-  for (const char* compression : {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "dwaa", "dwab"}) {
+  for (const char* compression : {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"}) {
     const CliRun r = run_cli(inputs() + " --device scalar --pixel-type half --compression " + compression +
                              " --out " + path(std::string("out/") + compression + ".####.exr"));
     ASSERT_EQ(r.exit_code, 0) << compression << ": " << r.output;

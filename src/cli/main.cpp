@@ -83,7 +83,7 @@ int main(int argc, char** argv) {
                         "unfogged pixels bit for bit")
       ->capture_default_str();
   apply_cmd->add_option("--compression", ap.compression,
-                        "Output compression: none, rle, zips, zip, piz, pxr24, b44, dwaa or dwab (default: the "
+                        "Output compression: none, rle, zips, zip, piz, pxr24, b44, b44a, dwaa or dwab (default: the "
                         "input's; other parts of a multi-part file are copied as stored)");
   apply_cmd->add_option("--near", ap.near_plane, "Camera near plane [world units], > 0")->required();
   apply_cmd->add_option("--far", ap.far_plane,

@@ -179,7 +179,8 @@ const struct {
   Imf::Compression compression;
 } kCompressions[] = {{"none", Imf::NO_COMPRESSION}, {"rle", Imf::RLE_COMPRESSION},   {"zips", Imf::ZIPS_COMPRESSION},
                      {"zip", Imf::ZIP_COMPRESSION},  {"piz", Imf::PIZ_COMPRESSION},   {"pxr24", Imf::PXR24_COMPRESSION},
-                     {"b44", Imf::B44_COMPRESSION},  {"dwaa", Imf::DWAA_COMPRESSION}, {"dwab", Imf::DWAB_COMPRESSION}};
+                     {"b44", Imf::B44_COMPRESSION},  {"b44a", Imf::B44A_COMPRESSION}, {"dwaa", Imf::DWAA_COMPRESSION},
+                     {"dwab", Imf::DWAB_COMPRESSION}};
 
 // A channel of the color part other than the fogged layer's R, G, B, A, kept in the output.
 struct KeptChannel {

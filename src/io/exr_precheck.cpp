@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "fogcl/error.h"
+#include "fogcl/exr_io.h"
 
 namespace fogcl::detail {
 
@@ -54,11 +55,6 @@ double max_expansion(int compression) {
     case 8: case 9: return 66048;
     default: return 0;
   }
-}
-
-const char* compression_name(int compression) {
-  static const char* const names[] = {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"};
-  return compression >= 0 && compression < 10 ? names[compression] : "unknown";
 }
 
 std::string bytes_text(double bytes) {
@@ -243,7 +239,7 @@ void precheck_exr_header(const std::string& name, std::uint64_t file_size, std::
                       std::to_string(data_box[0]) + ", " + std::to_string(data_box[1]) + ")-(" +
                       std::to_string(data_box[2]) + ", " + std::to_string(data_box[3]) + ") holds " +
                       bytes_text(pixel_bytes) + " bytes of " + (deep ? "deep sample counts" : "pixels") + "; " +
-                      compression_name(compression) + " compression and " + std::to_string(chunks) +
+                      exr_compression_name(compression) + " compression and " + std::to_string(chunks) +
                       " chunks store that in no fewer than " + bytes_text(std::ceil(least)) + " bytes";
     }
     if (multipart) {
