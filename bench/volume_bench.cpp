@@ -479,8 +479,26 @@ void BM_VolumeNothingVisible(benchmark::State& state) {
   state.counters["dispatches"] = double(pass.stats().march_dispatches + pass.stats().composite_dispatches);
 }
 
+// The host's culling input of every VolumePass::apply: the farthest eye depth of the 1080p frame.
+// sky:1 the demo frame (the first sky pixel ends the scan), sky:0 the same frame with its sky
+// replaced by the far ground (every pixel read).
+void BM_MaxEyeDepth(benchmark::State& state) {
+  const DemoFrame& f = frame(1920);
+  DepthImage depth = f.depth;
+  if (state.range(0) == 0) {
+    float ground = 0.0f;
+    for (std::size_t i = 0; i < depth.pixel_count(); ++i)
+      if (depth.data()[i] < 0.999f) ground = std::max(ground, depth.data()[i]);
+    for (std::size_t i = 0; i < depth.pixel_count(); ++i) depth.data()[i] = std::min(depth.data()[i], ground);
+  }
+  float farthest = 0.0f;
+  for (auto _ : state) benchmark::DoNotOptimize(farthest = max_eye_depth(depth, f.params));
+  state.counters["farthest"] = farthest;
+}
+
 }  // namespace
 
+BENCHMARK(BM_MaxEyeDepth)->ArgNames({"sky"})->Args({0})->Args({1})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_VolumeDevice)
     ->ArgNames({"integrator", "divisor", "noise_image", "width"})
     ->ArgsProduct({{0, 1}, {1, 2, 4}, {0, 1}, {480}})

@@ -49,7 +49,7 @@ TEST(HostStaging, SameBytesAsDirectForEverySizeAndStorage) {
   Passes p;
   EXPECT_EQ(p.staged.host_transfer(), HostTransfer::staged);
   EXPECT_EQ(p.direct.host_transfer(), HostTransfer::direct);
-  // 1x1, a width that is no multiple of 16, a frame of several 4 MiB bands with a short last one.
+  // 1x1, a width that is no multiple of 16, a frame of several 2 MiB bands with a short last one.
   const int sizes[][2] = {{1, 1}, {17, 3}, {320, 180}, {1000, 1333}};
   std::size_t worst = 0;
   for (const auto& wh : sizes)

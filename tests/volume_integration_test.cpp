@@ -4,6 +4,7 @@
 #include <cstring>
 #include <limits>
 
+#include "volume/volume_formulas.h"
 #include "volume_support.h"
 
 namespace fogcl::test {
@@ -125,6 +126,55 @@ TEST(VolumeCulling, FrustumAndDepthRange) {
   EXPECT_TRUE(std::isinf(max_eye_depth(t.frame.depth, t.frame.params)));
   DepthImage ground(4, 4, 0.5f);
   EXPECT_LT(max_eye_depth(ground, t.frame.params), t.frame.params.far_plane());
+}
+
+// max_eye_depth finds the farthest pixel from the smallest and largest stored values (and NaN):
+// the same float as the largest per-pixel eye depth, for every depth kind and projection, on
+// values inside and outside the range, sky, nothing written, NaN and +-inf.
+TEST(VolumeCulling, MaxEyeDepthIsTheLargestPixelEyeDepth) {
+  const float specials[] = {0.0f, -0.0f, 1.0f, -3.0f, 2.0f, 1000.0f, 0.99995f, INFINITY, -INFINITY,
+                            std::numeric_limits<float>::quiet_NaN()};
+  int cases = 0;
+  for (int projection = 0; projection < 3; ++projection)
+    for (int kind = 0; kind < 3; ++kind)
+      for (bool reversed : {false, true}) {
+        PerspectiveCamera p;
+        p.reversed_z = reversed || projection == 1;
+        p.infinite_far = projection == 1;
+        OrthographicCamera o;
+        o.reversed_z = reversed;
+        CameraParams camera = projection == 2 ? make_camera_params(o) : make_camera_params(p);
+        if (kind == 2 && projection == 2) continue;  // radial distance is perspective only
+        camera.depth_kind = DepthKind(kind);
+        for (unsigned seed = 0; seed < 24; ++seed) {
+          // Ordinary values of the kind's range, then up to two specials in some frames.
+          // The last frame spans two of max_eye_depth's 64K-pixel passes, a special in the second.
+          const bool large = seed == 23;
+          DepthImage depth(large ? 400 : 37, large ? 200 : 5);
+          unsigned x = seed * 2654435761u + 1u;
+          const float scale = kind == 0 ? 1.0f : 900.0f;
+          for (std::size_t i = 0; i < depth.pixel_count(); ++i) {
+            x = x * 1664525u + 1013904223u;
+            depth.data()[i] = 0.001f + scale * float(x >> 8) / float(1u << 24);
+          }
+          if (seed % 3 != 0) depth.data()[x % depth.pixel_count()] = specials[seed % 10];
+          if (seed % 4 == 1) depth.data()[(x >> 5) % depth.pixel_count()] = specials[(seed / 4) % 10];
+          if (large) depth.data()[depth.pixel_count() - 1 - x % 97] = specials[(projection * 3 + kind) % 10];
+          float expected = 0.0f;
+          for (std::size_t i = 0; i < depth.pixel_count() && expected < INFINITY; ++i) {
+            const float e = volume_formulas::vol_eye_depth(
+                depth.data()[i], int(camera.projection), camera.reversed_z, int(camera.depth_kind),
+                camera.zbuffer_params.x, camera.zbuffer_params.y, camera.near_plane(), camera.far_plane());
+            expected = e < INFINITY ? std::fmax(expected, e) : INFINITY;
+          }
+          const float got = max_eye_depth(depth, camera);
+          EXPECT_EQ(std::memcmp(&got, &expected, sizeof got), 0)
+              << "projection " << projection << " kind " << kind << " reversed " << reversed << " seed " << seed
+              << ": " << got << " against " << expected;
+          ++cases;
+        }
+      }
+  std::printf("[ worst    ] max_eye_depth against the per-pixel maximum: %d frames, every one the same float\n", cases);
 }
 
 TEST(VolumeValidation, BadInputNamesTheValueAndTheRule) {

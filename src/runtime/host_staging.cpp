@@ -3,8 +3,13 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <map>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "runtime/pinned_memory.h"
 
@@ -78,7 +83,8 @@ void CopyWorkers::run(int n, const std::function<void(int)>& task) {
 
 namespace {
 // Bands of ~2 MiB: large enough for the DMA engine's full rate, small enough that the first
-// transfer starts early and the copies spread over the threads.
+// transfer starts early and the copies spread over the threads. (First and last bands from
+// 256 KiB up, to shorten the pipeline's fill and drain, measured no faster on the H200's host.)
 constexpr std::size_t kBandBytes = std::size_t(2) << 20;
 // A caller that never waits must not exhaust memory.
 constexpr long kMaxInFlight = 16;
@@ -145,14 +151,39 @@ void StagedFrame::release() {
 // ---- HostStaging -------------------------------------------------------------------------------
 
 namespace {
-// The bus moves 54 GB/s each way, one core's memcpy ~10 (H100 host): 8 threads copy 45-49 GB/s,
-// 12 or 16 no more (bench/results/gpu-h100-2026-11-25-round-trip/band-sweep.md). At most the CPUs
-// this process may run on.
+// The bus moves 54 GB/s each way, one core's memcpy ~10 (H100 host): 8 threads copy 45-49 GB/s
+// with memcpy, 12 or 16 no more (bench/results/gpu-h100-2026-11-25-round-trip/band-sweep.md);
+// band_copy's non-temporal stores keep up with the bus. At most the CPUs this process may run on.
 int copy_threads() {
   cpu_set_t set;
   const int cpus = sched_getaffinity(0, sizeof set, &set) == 0 ? CPU_COUNT(&set)
                                                                 : int(std::thread::hardware_concurrency());
   return std::clamp(cpus, 1, 8);
+}
+
+// A band's copy between the caller's memory and the pinned memory, with non-temporal stores
+// where the CPU has them (SSE2, every x86-64): an ordinary store first reads the line it
+// overwrites, so a copy moves three times its bytes through DRAM instead of two, and none of
+// these bytes is read again by the CPU (the DMA reads the pinned ones, the caller the rest later).
+void band_copy(std::byte* dst, const std::byte* src, std::size_t n) {
+#if defined(__SSE2__)
+  std::size_t i = std::min(n, (16 - reinterpret_cast<std::uintptr_t>(dst) % 16) % 16);
+  std::memcpy(dst, src, i);
+  for (; i + 64 <= n; i += 64) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i));
+    const __m128i b = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i + 16));
+    const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i + 32));
+    const __m128i d = _mm_loadu_si128(reinterpret_cast<const __m128i*>(src + i + 48));
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i), a);
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + 16), b);
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + 32), c);
+    _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i + 48), d);
+  }
+  std::memcpy(dst + i, src + i, n - i);
+  _mm_sfence();  // the stores are visible before the DMA is enqueued or the frame handed back
+#else
+  std::memcpy(dst, src, n);
+#endif
 }
 }  // namespace
 
@@ -279,7 +310,7 @@ StagedFrame HostStaging::upload(const ColorImage& in, const DepthImage& depth) {
     const bool is_color = std::size_t(i) < copied_color;
     const Band b = is_color ? color_bands[i] : depth_bands[i - copied_color];
     std::byte* pinned = s.in + (is_color ? 0 : color) + b.offset;
-    std::memcpy(pinned, (is_color ? color_src : depth_src) + b.offset, b.bytes);
+    band_copy(pinned, (is_color ? color_src : depth_src) + b.offset, b.bytes);
     upload_queue_.enqueueWriteBuffer(is_color ? s.color_in : s.depth, CL_FALSE, b.offset, b.bytes, pinned);
   });
   upload_queue_.enqueueMarkerWithWaitList(nullptr, &s.uploaded);
@@ -320,7 +351,7 @@ void HostStaging::finish(StagedFrame& frame, ColorImage& out) {
   // Band b is copied out as soon as its DMA is done, while later bands still cross the bus.
   down_workers_.run(int(color_bands.size()), [&](int b) {
     s.downloads[b].wait();
-    if (!s.out_direct) std::memcpy(dst + color_bands[b].offset, s.out + color_bands[b].offset, color_bands[b].bytes);
+    if (!s.out_direct) band_copy(dst + color_bands[b].offset, s.out + color_bands[b].offset, color_bands[b].bytes);
   });
   frame.release();
 }
