@@ -206,6 +206,16 @@ TEST(HostStaging, VolumesSameBytesAsDirect) {
     staged.apply(t.frame.color, t.frame.depth, b, t.frame.params, t.scene, settings);
     EXPECT_EQ(differing_bytes(a, b), 0u) << to_string(format);
     EXPECT_GT(differing_bytes(b, t.frame.color), 0u) << "no volume visible: the check could not fail";
+    // From pinned images: the depth, on which the march starts, and the color cross uncopied.
+    const cl_context ctx = runtime()->context();
+    const cl_device_id dev = runtime()->device();
+    ColorImage color = pinned_color_image(ctx, dev, t.frame.color.width(), t.frame.color.height(), format);
+    DepthImage depth = pinned_depth_image(ctx, dev, t.frame.depth.width(), t.frame.depth.height());
+    std::memcpy(color.data(), t.frame.color.data(), color.size_bytes());
+    std::memcpy(depth.data(), t.frame.depth.data(), depth.size_bytes());
+    ColorImage c;
+    staged.apply(color, depth, c, t.frame.params, t.scene, settings);
+    EXPECT_EQ(differing_bytes(a, c), 0u) << to_string(format) << " from pinned images";
   }
 }
 

@@ -111,6 +111,7 @@ struct StagingSlot {
   std::byte* out = nullptr;               // pinned_out: color
   FrameBuffers raw;
   cl::Event uploaded, after;              // after: the passes' last event (download())
+  std::vector<cl::Event> depth_ready;     // the depth's transfers, sent before the color
   std::vector<cl::Event> downloads;       // one per band of color_out
   bool out_direct = false;                // downloaded into the caller's pinned image itself
   std::size_t color_bytes() const { return color_buffer_bytes(width, height, format); }
@@ -139,6 +140,7 @@ void StagedFrame::release() {
   if (slot_ == nullptr) return;
   StagingSlot* s = std::exchange(slot_, nullptr);
   try {
+    for (cl::Event& e : s->depth_ready) e.wait();
     if (s->uploaded()) s->uploaded.wait();
     if (s->after()) s->after.wait();
     for (cl::Event& e : s->downloads) e.wait();
@@ -228,6 +230,7 @@ void HostStaging::give_back(StagingSlot* slot) {
   slot->busy = false;
   slot->uploaded = cl::Event();
   slot->after = cl::Event();
+  slot->depth_ready.clear();
   slot->downloads.clear();
   slot->out_direct = false;
   // Frames beyond max_frames in flight got slots of their own: keep max_frames slots' memory.
@@ -289,41 +292,54 @@ StagingSlot& HostStaging::take_slot(int width, int height, ColorFormat format) {
   }
 }
 
-StagedFrame HostStaging::upload(const ColorImage& in, const DepthImage& depth) {
+// One image's bytes to a device buffer of the slot: where the image is pinned memory of this
+// context, straight from it (then `direct` is set); else band by band through the slot's pinned
+// memory at `pinned`, each band's DMA enqueued by the thread that filled it as soon as it is
+// filled. The transfers' events are appended to `events` (may be null).
+void HostStaging::upload_image(const std::byte* src, std::size_t bytes, const cl::Buffer& to, std::byte* pinned,
+                               bool& direct, std::vector<cl::Event>* events) {
+  direct = is_pinned(src, bytes, context_());
+  if (direct) {
+    cl::Event e;
+    upload_queue_.enqueueWriteBuffer(to, CL_FALSE, 0, bytes, src, nullptr, &e);
+    if (events) events->push_back(e);
+    return;
+  }
+  const std::vector<Band> image_bands = bands(bytes);
+  std::vector<cl::Event> done(image_bands.size());
+  up_workers_.run(int(image_bands.size()), [&](int i) {
+    const Band b = image_bands[i];
+    band_copy(pinned + b.offset, src + b.offset, b.bytes);
+    upload_queue_.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done[i]);
+  });
+  if (events) events->insert(events->end(), done.begin(), done.end());
+}
+
+StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes) {
   StagedFrame frame;
   frame.owner_ = this;
   frame.slot_ = &take_slot(in.width(), in.height(), in.format());
   StagingSlot& s = *frame.slot_;
-  const std::size_t color = s.color_bytes();
-  const std::vector<Band> color_bands = bands(color), depth_bands = bands(s.depth_bytes());
-  const auto* color_src = static_cast<const std::byte*>(in.data());
-  const auto* depth_src = reinterpret_cast<const std::byte*>(depth.data());
-  // A pinned image crosses the bus from where it is; the others through the slot's pinned memory.
-  const bool color_direct = is_pinned(color_src, color, context_());
-  const bool depth_direct = is_pinned(depth_src, s.depth_bytes(), context_());
-  if (color_direct) upload_queue_.enqueueWriteBuffer(s.color_in, CL_FALSE, 0, color, color_src);
-  if (depth_direct) upload_queue_.enqueueWriteBuffer(s.depth, CL_FALSE, 0, s.depth_bytes(), depth_src);
-  const std::size_t copied_color = color_direct ? 0 : color_bands.size();
-  const std::size_t copied_depth = depth_direct ? 0 : depth_bands.size();
-  // Each band's DMA is enqueued by the thread that filled it, as soon as it is filled.
-  up_workers_.run(int(copied_color + copied_depth), [&](int i) {
-    const bool is_color = std::size_t(i) < copied_color;
-    const Band b = is_color ? color_bands[i] : depth_bands[i - copied_color];
-    std::byte* pinned = s.in + (is_color ? 0 : color) + b.offset;
-    band_copy(pinned, (is_color ? color_src : depth_src) + b.offset, b.bytes);
-    upload_queue_.enqueueWriteBuffer(is_color ? s.color_in : s.depth, CL_FALSE, b.offset, b.bytes, pinned);
-  });
-  upload_queue_.enqueueMarkerWithWaitList(nullptr, &s.uploaded);
+  // A throw before the download is queued drops `frame`, which waits for what was enqueued.
+  // The depth goes first, so that what reads only the depth (the volumes' march) runs while the
+  // color is copied and crosses the bus.
+  bool depth_direct = false, color_direct = false, color_sent = false;
+  upload_image(reinterpret_cast<const std::byte*>(depth.data()), s.depth_bytes(), s.depth, s.in + s.color_bytes(),
+               depth_direct, &s.depth_ready);
   upload_queue_.flush();
+  const UploadColor upload_color = [&] {
+    if (color_sent) throw Error("HostStaging: the color was uploaded twice");
+    color_sent = true;
+    upload_image(static_cast<const std::byte*>(in.data()), s.color_bytes(), s.color_in, s.in, color_direct, nullptr);
+    upload_queue_.enqueueMarkerWithWaitList(nullptr, &s.uploaded);
+    upload_queue_.flush();
+    return s.uploaded;
+  };
+  const cl::Event after = passes(s.raw, s.depth_ready, upload_color);
+  if (!color_sent) upload_color();  // passes that never read the color: the download still follows it
   // The caller may change its images once this returns: the DMA from them must be over.
   if (color_direct || depth_direct) s.uploaded.wait();
-  return frame;
-}
-
-StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes) {
-  // A throw before the download is queued drops `frame`, which waits for what was enqueued.
-  StagedFrame frame = upload(in, depth);
-  download(frame, passes(frame.slot_->raw, frame.slot_->uploaded), out);
+  download(frame, after, out);
   return frame;
 }
 

@@ -91,26 +91,32 @@ class HostStaging {
   static std::shared_ptr<HostStaging> shared(const cl::Context& context, const cl::Device& device);
 
   // max_frames >= 1: the frames in flight whose slots stay allocated (three: upload, kernels and
-  // download of consecutive frames). More may be in flight, up to 16 (then upload() throws).
+  // download of consecutive frames). More may be in flight, up to 16 (then start() throws).
   HostStaging(const cl::Context& context, const cl::Device& device, int max_frames = 3);
   ~HostStaging();
   HostStaging(const HostStaging&) = delete;
   HostStaging& operator=(const HostStaging&) = delete;
 
   // A convenience call's round trip up to the result's download, with no host wait: in and depth
-  // (same size) go up through a free slot's pinned memory, passes(buffers, uploaded) enqueues the
-  // passes on the slot's device buffers after `uploaded` and returns their last event, and the
-  // download of buffers.color_out into `out` follows it. Returns once the host images may be
-  // reused (the DMA from the slot may still run); an image in pinned memory of this context
-  // (pinned_memory.h) crosses the bus from where it is, uncopied (then this waits for that DMA).
-  using Passes = std::function<cl::Event(const FrameBuffers& buffers, const cl::Event& uploaded)>;
+  // (same size) go up through a free slot's pinned memory, the depth first.
+  // passes(buffers, depth_ready, upload_color) enqueues the passes on the slot's device buffers:
+  // what reads only the depth after depth_ready, then calls upload_color(), which sends the color
+  // up and returns the event after which color and depth are on the device, and enqueues the rest
+  // after it; it returns the passes' last event, which the download of buffers.color_out into
+  // `out` follows. Returns once the host images may be reused (the DMA from the slot may still
+  // run); an image in pinned memory of this context (pinned_memory.h) crosses the bus from where
+  // it is, uncopied (then this waits for that DMA).
+  using UploadColor = std::function<cl::Event()>;
+  using Passes = std::function<cl::Event(const FrameBuffers& buffers, const std::vector<cl::Event>& depth_ready,
+                                         const UploadColor& upload_color)>;
   StagedFrame start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes);
   // Waits for the download and copies it into `out` (the image given to start()); then the slot
   // is free for the next frame. Thread-safe against start() of other frames.
   void finish(StagedFrame& frame, ColorImage& out);
 
  private:
-  StagedFrame upload(const ColorImage& in, const DepthImage& depth);
+  void upload_image(const std::byte* src, std::size_t bytes, const cl::Buffer& to, std::byte* pinned, bool& direct,
+                    std::vector<cl::Event>* events);
   void download(StagedFrame& frame, const cl::Event& after, ColorImage& out);
   friend class StagedFrame;
   void give_back(StagingSlot* slot);

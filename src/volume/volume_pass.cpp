@@ -82,6 +82,13 @@ struct VolumePass::Impl {
   }
   const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
                                     std::vector<cl::Event>& waits);
+  // VolumePass::enqueue's work after `waits`. after_march (may be empty) runs once the march is
+  // enqueued and flushed (the march reads the depth, not the color) and returns what the
+  // composite waits for besides the march: the staged call sends the color up there.
+  using AfterMarch = std::function<std::vector<cl::Event>()>;
+  cl::Event enqueue_frame(const cl::CommandQueue& queue, const FrameBuffers& fb, const CameraParams& camera,
+                          const VolumeScene& scene, const VolumeSettings& requested, const ShadowMapBuffer* shadow,
+                          std::vector<cl::Event> waits, const AfterMarch& after_march, float max_eye);
   // `settings` with its noise sampling resolved for this device: what the variant, its build
   // options and the noise upload are chosen from.
   VolumeSettings resolved(const VolumeSettings& settings) const {
@@ -189,93 +196,111 @@ void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, c
 cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
                              const VolumeScene& scene, const VolumeSettings& requested, const ShadowMapBuffer* shadow,
                              const std::vector<cl_event>& wait_list, float max_eye) {
-  Impl& m = *impl_;
+  return with_cl_errors([&] {
+    const cl::CommandQueue queue =
+        detail::checked_queue(queue_handle, impl_->context, impl_->device, "VolumePass::enqueue");
+    std::vector<cl::Event> waits;
+    for (cl_event e : wait_list) waits.push_back(wrap(e));
+    return share(impl_->enqueue_frame(queue, fb, camera, scene, requested, shadow, std::move(waits), {}, max_eye));
+  });
+}
+
+cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const FrameBuffers& fb,
+                                          const CameraParams& camera, const VolumeScene& scene,
+                                          const VolumeSettings& requested, const ShadowMapBuffer* shadow,
+                                          std::vector<cl::Event> waits, const AfterMarch& after_march,
+                                          float max_eye) {
+  Impl& m = *this;
   const VolumeSettings settings = m.resolved(requested);
   const detail::PackedVolumeFrame f =
       detail::pack_volume_frame(fb.width, fb.height, camera, scene, settings, fb.format,
                                 shadow ? &shadow->params : nullptr, shadow ? shadow->width : 0,
                                 shadow ? shadow->height : 0, max_eye);
-  return with_cl_errors([&] {
-    const cl::CommandQueue queue = detail::checked_queue(queue_handle, m.context, m.device, "VolumePass::enqueue");
-    detail::check_frame_buffers(fb, m.context);
-    if (shadow) {
-      if (shadow->depth == nullptr) throw Error("shadow map buffer is not set (null cl_mem)");
-      const std::size_t needed = depth_buffer_bytes(shadow->width, shadow->height);
-      const std::size_t size = wrap(shadow->depth).getInfo<CL_MEM_SIZE>();
-      if (size != needed)
-        throw Error("shadow map buffer holds " + std::to_string(size) + " bytes but a " +
-                    std::to_string(shadow->width) + "x" + std::to_string(shadow->height) +
-                    " float32 map needs exactly " + std::to_string(needed));
+  detail::check_frame_buffers(fb, m.context);
+  if (shadow) {
+    if (shadow->depth == nullptr) throw Error("shadow map buffer is not set (null cl_mem)");
+    const std::size_t needed = depth_buffer_bytes(shadow->width, shadow->height);
+    const std::size_t size = wrap(shadow->depth).getInfo<CL_MEM_SIZE>();
+    if (size != needed)
+      throw Error("shadow map buffer holds " + std::to_string(size) + " bytes but a " +
+                  std::to_string(shadow->width) + "x" + std::to_string(shadow->height) +
+                  " float32 map needs exactly " + std::to_string(needed));
+  }
+  cl::Event done;
+  m.stats.volumes_culled += scene.volumes.size() - f.visible.size();
+  if (f.visible.empty()) {  // nothing to draw: no kernel, the output is the input
+    m.last_march_options.clear();
+    m.last_composite_options.clear();
+    ++m.stats.frames_without_volumes;
+    if (after_march) {
+      const std::vector<cl::Event> more = after_march();
+      waits.insert(waits.end(), more.begin(), more.end());
     }
-    std::vector<cl::Event> waits;
-    for (cl_event e : wait_list) waits.push_back(wrap(e));
-    cl::Event done;
-    m.stats.volumes_culled += scene.volumes.size() - f.visible.size();
-    if (f.visible.empty()) {  // nothing to draw: no kernel, the output is the input
-      m.last_march_options.clear();
-      m.last_composite_options.clear();
-      ++m.stats.frames_without_volumes;
-      if (fb.color_out == fb.color_in)
-        queue.enqueueMarkerWithWaitList(waits.empty() ? nullptr : &waits, &done);
-      else
-        queue.enqueueCopyBuffer(wrap(fb.color_in), wrap(fb.color_out), 0, 0,
-                                color_buffer_bytes(fb.width, fb.height, fb.format), waits.empty() ? nullptr : &waits,
-                                &done);
-      return share(done);
-    }
-    const std::string march_options = detail::volume_march_options(f.variant, m.traits);
-    const std::string composite_options = detail::volume_composite_options(f.variant, m.traits);
-    Impl::KernelEntry& march_entry =
-        m.prepared_kernel(kMarch, march_options, detail::volume_march_private_bytes(f.variant, m.traits));
-    Impl::KernelEntry& composite_entry =
-        m.prepared_kernel(kComposite, composite_options, detail::volume_composite_private_bytes(f.variant, m.traits));
-    cl::Kernel& march = march_entry.kernel;
-    cl::Kernel& composite = composite_entry.kernel;
-    m.last_march_options = march_options;
-    m.last_composite_options = composite_options;
-    const cl::Buffer frame = constant_buffer(m.context, f.frame.data(), f.frame.size());
-    const cl::Buffer volumes = constant_buffer(m.context, f.volumes.data(), f.volumes.size());
-    const std::size_t low_pixels = std::size_t(f.low_width) * std::size_t(f.low_height);
-    // Released with this call: OpenCL keeps them until the kernels that use them are done.
-    const cl::Buffer low(m.context, CL_MEM_READ_WRITE, low_pixels * 4 * sizeof(float));
-    const cl::Buffer low_key(m.context, CL_MEM_READ_WRITE, low_pixels * sizeof(float));
-    const cl::Buffer depth = wrap(fb.depth);
-    int arg = 0;
-    march.setArg(arg++, depth);
-    march.setArg(arg++, frame);
-    march.setArg(arg++, volumes);
-    march.setArg(arg++, cl_int(f.visible.size()));
-    if (f.needs_noise()) {
-      march.setArg(arg++, m.noise_on_device(queue, settings, waits));
-      march.setArg(arg++, cl_int(settings.noise_size));
-    } else {
-      march.setArg(arg++, frame);  // unused: a variant without noise never reads it
-      march.setArg(arg++, cl_int(0));
-    }
-    march.setArg(arg++, shadow ? wrap(shadow->depth) : frame);
-    march.setArg(arg++, cl_uint(scene.frame_index));
-    march.setArg(arg++, low);
-    march.setArg(arg++, low_key);
-    cl::Event marched;
-    const int march_lanes = detail::volume_march_lanes(f.variant, m.traits);  // target pixels per work-item
-    queue.enqueueNDRangeKernel(march, cl::NullRange,
-                               march_entry.shape.global(std::size_t((f.low_width + march_lanes - 1) / march_lanes),
-                                                        std::size_t(f.low_height)),
-                               march_entry.shape.local(), waits.empty() ? nullptr : &waits, &marched);
-    ++m.stats.march_dispatches;
-    composite.setArg(0, wrap(fb.color_in));
-    composite.setArg(1, depth);
-    composite.setArg(2, wrap(fb.color_out));
-    composite.setArg(3, frame);
-    composite.setArg(4, low);
-    composite.setArg(5, low_key);
-    const std::vector<cl::Event> after{marched};
-    const auto global = detail::volume_composite_global(f.variant, m.traits, fb.width, fb.height);
-    queue.enqueueNDRangeKernel(composite, cl::NullRange, composite_entry.shape.global(global[0], global[1]),
-                               composite_entry.shape.local(), &after, &done);
-    ++m.stats.composite_dispatches;
-    return share(done);
-  });
+    if (fb.color_out == fb.color_in)
+      queue.enqueueMarkerWithWaitList(waits.empty() ? nullptr : &waits, &done);
+    else
+      queue.enqueueCopyBuffer(wrap(fb.color_in), wrap(fb.color_out), 0, 0,
+                              color_buffer_bytes(fb.width, fb.height, fb.format), waits.empty() ? nullptr : &waits,
+                              &done);
+    return done;
+  }
+  const std::string march_options = detail::volume_march_options(f.variant, m.traits);
+  const std::string composite_options = detail::volume_composite_options(f.variant, m.traits);
+  Impl::KernelEntry& march_entry =
+      m.prepared_kernel(kMarch, march_options, detail::volume_march_private_bytes(f.variant, m.traits));
+  Impl::KernelEntry& composite_entry =
+      m.prepared_kernel(kComposite, composite_options, detail::volume_composite_private_bytes(f.variant, m.traits));
+  cl::Kernel& march = march_entry.kernel;
+  cl::Kernel& composite = composite_entry.kernel;
+  m.last_march_options = march_options;
+  m.last_composite_options = composite_options;
+  const cl::Buffer frame = constant_buffer(m.context, f.frame.data(), f.frame.size());
+  const cl::Buffer volumes = constant_buffer(m.context, f.volumes.data(), f.volumes.size());
+  const std::size_t low_pixels = std::size_t(f.low_width) * std::size_t(f.low_height);
+  // Released with this call: OpenCL keeps them until the kernels that use them are done.
+  const cl::Buffer low(m.context, CL_MEM_READ_WRITE, low_pixels * 4 * sizeof(float));
+  const cl::Buffer low_key(m.context, CL_MEM_READ_WRITE, low_pixels * sizeof(float));
+  const cl::Buffer depth = wrap(fb.depth);
+  int arg = 0;
+  march.setArg(arg++, depth);
+  march.setArg(arg++, frame);
+  march.setArg(arg++, volumes);
+  march.setArg(arg++, cl_int(f.visible.size()));
+  if (f.needs_noise()) {
+    march.setArg(arg++, m.noise_on_device(queue, settings, waits));
+    march.setArg(arg++, cl_int(settings.noise_size));
+  } else {
+    march.setArg(arg++, frame);  // unused: a variant without noise never reads it
+    march.setArg(arg++, cl_int(0));
+  }
+  march.setArg(arg++, shadow ? wrap(shadow->depth) : frame);
+  march.setArg(arg++, cl_uint(scene.frame_index));
+  march.setArg(arg++, low);
+  march.setArg(arg++, low_key);
+  cl::Event marched;
+  const int march_lanes = detail::volume_march_lanes(f.variant, m.traits);  // target pixels per work-item
+  queue.enqueueNDRangeKernel(march, cl::NullRange,
+                             march_entry.shape.global(std::size_t((f.low_width + march_lanes - 1) / march_lanes),
+                                                      std::size_t(f.low_height)),
+                             march_entry.shape.local(), waits.empty() ? nullptr : &waits, &marched);
+  ++m.stats.march_dispatches;
+  composite.setArg(0, wrap(fb.color_in));
+  composite.setArg(1, depth);
+  composite.setArg(2, wrap(fb.color_out));
+  composite.setArg(3, frame);
+  composite.setArg(4, low);
+  composite.setArg(5, low_key);
+  std::vector<cl::Event> after{marched};
+  if (after_march) {
+    queue.flush();  // the march may start while after_march works
+    const std::vector<cl::Event> more = after_march();
+    after.insert(after.end(), more.begin(), more.end());
+  }
+  const auto global = detail::volume_composite_global(f.variant, m.traits, fb.width, fb.height);
+  queue.enqueueNDRangeKernel(composite, cl::NullRange, composite_entry.shape.global(global[0], global[1]),
+                             composite_entry.shape.local(), &after, &done);
+  ++m.stats.composite_dispatches;
+  return done;
 }
 
 void VolumePass::set_host_transfer(HostTransfer transfer) { impl_->transfers.choice = transfer; }
@@ -319,9 +344,12 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
     if (m.staged()) {  // pinned staging (runtime/host_staging.h): the GPU default
       detail::HostStaging& staging = m.transfers.staging_of(m.context, m.device);
       detail::StagedFrame staged =
-          staging.start(in, depth, out, [&](const FrameBuffers& fb, const cl::Event& uploaded) {
-            const cl::Event done = adopt(enqueue(m.queue(), fb, camera, scene, settings, shadow ? &sm : nullptr,
-                                                 {uploaded()}, max_eye));
+          staging.start(in, depth, out, [&](const FrameBuffers& fb, const std::vector<cl::Event>& depth_ready,
+                                            const detail::HostStaging::UploadColor& upload_color) {
+            // The march reads the depth only: it runs while the color is sent up.
+            const cl::Event done = m.enqueue_frame(
+                m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, depth_ready,
+                [&] { return std::vector<cl::Event>{upload_color()}; }, max_eye);
             m.queue.flush();
             return done;
           });
