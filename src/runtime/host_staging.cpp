@@ -336,7 +336,7 @@ StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, Co
     return s.uploaded;
   };
   const cl::Event after = passes(s.raw, s.depth_ready, upload_color);
-  if (!color_sent) upload_color();  // passes that never read the color: the download still follows it
+  if (!color_sent) upload_color();  // every frame sends its color: `uploaded` ends the upload
   // The caller may change its images once this returns: the DMA from them must be over.
   if (color_direct || depth_direct) s.uploaded.wait();
   download(frame, after, out);
