@@ -14,6 +14,12 @@ struct CameraBasis {
   glm::dvec3 right, up, forward;
 };
 
+// Whether up is (nearly) parallel to forward, which leaves no basis: the rule of every pose check
+// (the library's validate, the CLI's flags). Both non-zero.
+inline bool up_parallel_to_forward(const glm::vec3& up, const glm::vec3& forward) {
+  return glm::length(glm::cross(glm::normalize(glm::dvec3(up)), glm::normalize(glm::dvec3(forward)))) < 1e-4;
+}
+
 // right = normalize(cross(up, forward)), up' = cross(forward, right), forward normalised.
 inline CameraBasis camera_basis(const CameraPose& p) {
   const glm::dvec3 f = glm::normalize(glm::dvec3(p.forward));

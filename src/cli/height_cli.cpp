@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "camera/camera_basis.h"
 #include "cli/cli.h"
 #include "cli/number_list.h"
 #include "cli/usage.h"
@@ -96,8 +97,7 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
     if (p.forward == glm::vec3(0.0f))
       throw Error("--forward must be a non-zero vector (got '" + ap.volumes.forward + "')");
     if (p.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + ap.volumes.up + "')");
-    const glm::dvec3 f = glm::normalize(glm::dvec3(p.forward)), u = glm::normalize(glm::dvec3(p.up));
-    if (glm::length(glm::cross(u, f)) < 1e-4)
+    if (detail::up_parallel_to_forward(p.up, p.forward))
       throw Error("--up must not be parallel to --forward (got --up '" + ap.volumes.up + "', --forward '" +
                   ap.volumes.forward + "')");
     const glm::mat3 to_fogcl = axes_to_fogcl(axes);

@@ -89,8 +89,7 @@ void validate(const CameraPose& p) {
     throw Error("camera forward must be a finite non-zero vector (got " + str(p.forward) + ")");
   if (!finite(p.up) || glm::length(p.up) == 0.0f)
     throw Error("camera up must be a finite non-zero vector (got " + str(p.up) + ")");
-  const glm::dvec3 f = glm::normalize(glm::dvec3(p.forward)), u = glm::normalize(glm::dvec3(p.up));
-  if (glm::length(glm::cross(u, f)) < 1e-4)
+  if (detail::up_parallel_to_forward(p.up, p.forward))
     throw Error("camera up " + str(p.up) + " must not be parallel to forward " + str(p.forward));
 }
 
