@@ -19,6 +19,9 @@ inline float load(const float* p) { return *p; }
 inline void store(float* p, float v) { *p = v; }
 inline float load(const std::uint16_t* p) { return _cvtsh_ss(*p); }
 inline void store(std::uint16_t* p, float v) { *p = _cvtss_sh(v, _MM_FROUND_TO_NEAREST_INT); }
+// v in the storage of `like`.
+inline float converted(float v, float) { return v; }
+inline std::uint16_t converted(float v, std::uint16_t) { return _cvtss_sh(v, _MM_FROUND_TO_NEAREST_INT); }
 
 // One row at a time: the factors first (a loop GCC vectorises, mode and metric as template
 // parameters so the loop has no branches), then the blend over the row's RGBA interleaved channels.
@@ -62,10 +65,12 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
   }
 }
 
-// Height fog (docs/DESIGN.md §6): the same formulas per pixel, kFeatures (fog_math.h FOG_HF_*) a
-// compile-time constant as in the kernel (-1: `runtime_features`, for scenes the benchmark does not
-// time); one loop over the row (the channels are not separable).
-template <int kFeatures, class Channel>
+// Height fog (docs/DESIGN.md §6): the same formulas per pixel, kFeatures (fog_math.h FOG_HF_*) and,
+// with kRawPerspective, the camera's kind (raw depth, conventional Z, perspective) compile-time
+// constants as in the kernel, so that the row's loop has no branch and GCC vectorises it (-1 / false:
+// runtime values, for scenes the benchmark does not time); one loop over the row (the channels are
+// not separable).
+template <int kFeatures, bool kRawPerspective, class Channel>
 void run_height(const Channel* in, const float* depth, Channel* out, int w, int h, const CameraParams& cam,
                 const detail::HeightCoefficients<float>& k, int threads, int runtime_features = 0) {
   using namespace formulas;
@@ -73,7 +78,9 @@ void run_height(const Channel* in, const float* depth, Channel* out, int w, int 
   const float zx = cam.zbuffer_params.x, zy = cam.zbuffer_params.y;
   const float near_plane = cam.near_plane(), far_plane = cam.far_plane();
   const auto c = fog_ray_corners(cam);
-  const int projection = int(cam.projection), reversed = cam.reversed_z, kind = int(cam.depth_kind);
+  const int projection = kRawPerspective ? FOG_PROJECTION_PERSPECTIVE : int(cam.projection);
+  const int reversed = kRawPerspective ? 0 : int(cam.reversed_z);
+  const int kind = kRawPerspective ? FOG_DEPTH_RAW : int(cam.depth_kind);
   const float inv_width = 1.0f / float(w);
 #pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < h; ++y) {
@@ -94,15 +101,10 @@ void run_height(const Channel* in, const float* depth, Channel* out, int w, int 
                                               k.light[1], k.light[2], (features & FOG_HF_SUN) != 0, k.d0, &sky, &wy,
                                               &d0, &q);
       float rgb[3] = {load(ci + 4 * x), load(ci + 4 * x + 1), load(ci + 4 * x + 2)};
-      if (fog_height_pixel(rgb, s_hit, sky, wy, d0, q, k.p, features)) {
-        store(co + 4 * x + 0, rgb[0]);
-        store(co + 4 * x + 1, rgb[1]);
-        store(co + 4 * x + 2, rgb[2]);
-      } else {
-        co[4 * x + 0] = ci[4 * x + 0];
-        co[4 * x + 1] = ci[4 * x + 1];
-        co[4 * x + 2] = ci[4 * x + 2];
-      }
+      const bool fogged = fog_height_pixel(rgb, s_hit, sky, wy, d0, q, k.p, features);
+      // Selects, not a branch (GCC vectorises no loop with control flow): a pixel not fogged keeps
+      // its stored bits, as in the kernel.
+      for (int j = 0; j < 3; ++j) co[4 * x + j] = fogged ? converted(rgb[j], ci[4 * x + j]) : ci[4 * x + j];
       co[4 * x + 3] = ci[4 * x + 3];
     }
   }
@@ -114,11 +116,14 @@ void dispatch_height(const Channel* in, const float* depth, Channel* out, int w,
   const auto k = detail::height_coefficients<float>(s, cam);
   const int features = v.height_features | (v.fog_skybox ? FOG_HF_SKYBOX : 0);
   // The benchmark's two scenes as constants (fog_bench.cpp case_of, modes 3 and 4).
-  constexpr int kValley = FOG_HF_FALLOFF;
-  constexpr int kHaze = FOG_HF_FALLOFF | FOG_HF_RGB | FOG_HF_SUN | FOG_HF_SKYBOX;
-  if (features == kValley) return run_height<kValley>(in, depth, out, w, h, cam, k, threads);
-  if (features == kHaze) return run_height<kHaze>(in, depth, out, w, h, cam, k, threads);
-  run_height<-1>(in, depth, out, w, h, cam, k, threads, features);
+  // In-scattering equal to extinction in both (FOG_HF_SAME_IN, as select_variant finds).
+  constexpr int kValley = FOG_HF_FALLOFF | FOG_HF_SAME_IN;
+  constexpr int kHaze = FOG_HF_FALLOFF | FOG_HF_RGB | FOG_HF_SUN | FOG_HF_SKYBOX | FOG_HF_SAME_IN;
+  const bool raw_perspective = cam.depth_kind == DepthKind::raw && !cam.reversed_z &&
+                               cam.projection == Projection::perspective;
+  if (raw_perspective && features == kValley) return run_height<kValley, true>(in, depth, out, w, h, cam, k, threads);
+  if (raw_perspective && features == kHaze) return run_height<kHaze, true>(in, depth, out, w, h, cam, k, threads);
+  run_height<-1, false>(in, depth, out, w, h, cam, k, threads, features);
 }
 
 template <class Channel>
