@@ -583,17 +583,15 @@ void BM_PinnedTransfer(benchmark::State& state) {
   // The host side: three regions, the inputs' sources and the output's destination.
   const std::size_t sizes[3] = {color_bytes, depth_bytes, color_bytes};
   void* host[3] = {};
-  cl::Buffer staging[3];  // pinned: the CL_MEM_ALLOC_HOST_PTR buffers behind host[]
-  std::unique_ptr<void, decltype(&std::free)> pageable[3] = {{nullptr, std::free}, {nullptr, std::free}, {nullptr, std::free}};
-  constexpr std::size_t kPage = 4096;
+  cl::Buffer staging[3];                // pinned: the CL_MEM_ALLOC_HOST_PTR buffers behind host[]
+  fogcl::detail::AlignedBytes pageable[3];  // pageable: page-aligned, as the images' own storage
   for (int i = 0; i < 3; ++i) {
     if (pinned) {
       staging[i] = cl::Buffer(ctx, CL_MEM_READ_WRITE | CL_MEM_ALLOC_HOST_PTR, sizes[i]);
       host[i] = queue.enqueueMapBuffer(staging[i], CL_TRUE, CL_MAP_READ | CL_MAP_WRITE, 0, sizes[i]);
     } else {
-      pageable[i].reset(std::aligned_alloc(kPage, (sizes[i] + kPage - 1) / kPage * kPage));
-      if (!pageable[i]) return state.SkipWithError("cannot allocate the pageable host memory");
-      host[i] = pageable[i].get();
+      pageable[i] = fogcl::detail::AlignedBytes(sizes[i]);
+      host[i] = pageable[i].data();
     }
     std::memset(host[i], 0x3c, sizes[i]);  // first touch, outside the timing
   }

@@ -311,9 +311,7 @@ static inline void fog_height_pixels16(global const COLOR_T* color_in, global co
   fog_store_quad(FOG_H_MERGE(rg1, ba1, 8), out, 3, k);
 #undef FOG_H_MERGE
 #ifdef FOG_COLOR_HALF
-  if (keep != 0)
-    for (uint j = 0; j < 16; ++j)
-      if (keep & (1u << j)) vstore2(vload2(j, in_bits), j, out_bits);
+  if (keep != 0) fog_restore_kept(keep, in_bits, out_bits);
 #endif
 }
 #define fog_pixels16 fog_height_pixels16

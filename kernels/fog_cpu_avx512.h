@@ -52,19 +52,13 @@
 typedef float fog_v16f __attribute__((__vector_size__(64)));
 typedef short fog_v16h __attribute__((__vector_size__(32), aligned(2)));
 
-/* Lanes rounded up to an integer: one vrndscaleps (PoCL's ceil is a 12-instruction routine). */
-static inline float16 fog_ceil_avx512(float16 x) {
-  return __builtin_bit_cast(float16, __builtin_ia32_rndscaleps_mask(
-      __builtin_bit_cast(fog_v16f, x), 0x0a /* round up, no precision exception */,
-      (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
-}
-
-/* Lanes rounded down to an integer: one vrndscaleps (PoCL's floor is a 12-instruction routine). */
-static inline float16 fog_floor_avx512(float16 x) {
-  return __builtin_bit_cast(float16, __builtin_ia32_rndscaleps_mask(
-      __builtin_bit_cast(fog_v16f, x), 0x09 /* round down, no precision exception */,
-      (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */));
-}
+/* Lanes rounded to an integer by one vrndscaleps (PoCL's ceil and floor are 12-instruction
+ * routines); imm: 0x0a up, 0x09 down (no precision exception), a literal. */
+#define FOG_RNDSCALE_AVX512(x, imm)                                                                   \
+  __builtin_bit_cast(float16, __builtin_ia32_rndscaleps_mask(__builtin_bit_cast(fog_v16f, (x)), (imm), \
+                                                             (fog_v16f){}, (ushort)0xffff, 4 /* current rounding */))
+static inline float16 fog_ceil_avx512(float16 x) { return FOG_RNDSCALE_AVX512(x, 0x0a); }
+static inline float16 fog_floor_avx512(float16 x) { return FOG_RNDSCALE_AVX512(x, 0x09); }
 
 /* p * 2^n for an integral n, rounded once: one vscalefps (height fog's e^x, whose n reaches -150
  * and 129, needs two multiplies otherwise). */

@@ -63,6 +63,13 @@ static inline void fog_copy_block(global const uint* in_bits, global uint* out_b
                   FOG_COPY16(in_bits + w, out_bits + w));
 }
 
+/* Half storage: the pixels whose bit j is set in `keep` copied back over the block's stores, bit
+ * for bit (a half -> float -> half trip would quiet a signalling NaN). */
+static inline void fog_restore_kept(uint keep, global const uint* in_bits, global uint* out_bits) {
+  for (uint j = 0; j < 16; ++j)
+    if (keep & (1u << j)) vstore2(vload2(j, in_bits), j, out_bits);
+}
+
 /* Pixel j's factor in its R, G, B lanes and 1 in its alpha lane (q: pixels 4q..4q+3, a literal),
  * which makes fog_blend pass alpha through. */
 #define FOG_QUAD_FACTORS(f, q)                                                                     \
@@ -135,8 +142,7 @@ static inline void fog_pixels16(global const COLOR_T* color_in, global const flo
   FOG_QUAD_BLEND(3)
 #undef FOG_QUAD_BLEND
 #ifdef FOG_COLOR_HALF
-  for (uint j = 0; j < 16; ++j)
-    if (keep & (1u << j)) vstore2(vload2(j, in_bits), j, out_bits);
+  fog_restore_kept(keep, in_bits, out_bits);
 #endif
 }
 #undef FOG_QUAD_FACTORS

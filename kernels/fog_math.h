@@ -7,8 +7,9 @@
  *     same text runs in float for the baseline and in double for the reference.
  * In OpenCL C this file defines the instance's macros itself (below): the one-pixel instance, or
  * the 16-pixel one when the includer defines FOG_LANES16; the includer defines FOG_EXP2 and may
- * define the optional hooks FOG_CEIL, FOG_FLOOR, FOG_SCALE2 (p 2^n, one rounding) and FOG_EXP2_LDEXP. In C++ the includer defines FOG_INT,
- * FOG_NAME, FOG_TRUNC_INT, FOG_TO_REAL and FOG_AS_REAL. This file has no include guard on purpose
+ * define the optional hooks FOG_CEIL, FOG_FLOOR, FOG_SCALE2 (p 2^n, one rounding) and
+ * FOG_EXP2_LDEXP. In C++ the includer defines FOG_INT, FOG_NAME, FOG_TRUNC_INT, FOG_TO_REAL and
+ * FOG_AS_REAL. This file has no include guard on purpose
  * and undefines the instance macros (not FOG_EXP2) at its end. Only operations that exist in both languages
  * appear: + - * /, fma, expm1, sqrt, fmin, fmax, integer + and <<, a float -> int conversion, and
  * ?: (a per-lane select on vectors in OpenCL C), besides the optional hooks.

@@ -184,6 +184,16 @@ CameraPose renderer_pose(const CameraCliOptions& o, const ExrInput& color, std::
   }
 }
 
+CameraPose flag_pose(const VolumeCliOptions& v) {
+  CameraPose p;
+  p.eye = parse_finite_vec3("--eye", v.eye);
+  p.forward = parse_finite_vec3("--forward", v.forward);
+  p.up = parse_finite_vec3("--up", v.up);
+  if (p.forward == glm::vec3(0.0f)) throw Error("--forward must be a non-zero vector (got '" + v.forward + "')");
+  if (p.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + v.up + "')");
+  return p;
+}
+
 std::string pose_text(const CameraPose& p) {
   char buf[256];
   std::snprintf(buf, sizeof buf, "eye (%g, %g, %g), forward (%g, %g, %g), up (%g, %g, %g)", double(p.eye.x),

@@ -60,6 +60,10 @@ std::optional<CameraPose> frame_pose(const CameraCliOptions& o, const VolumeCliO
 // from the color file (height fog's, which takes it whenever --eye/--forward/--up are not given).
 CameraPose renderer_pose(const CameraCliOptions& o, const ExrInput& color, std::string* from);
 
+// --eye/--forward/--up as given (the flags' own world, before --axes): each finite, forward and up
+// non-zero, or an error naming the flag. Whether up is parallel to forward each caller says.
+CameraPose flag_pose(const VolumeCliOptions& volumes);
+
 // "eye (X, Y, Z), forward (X, Y, Z), up (X, Y, Z)" (%g), for --verbose.
 std::string pose_text(const CameraPose& pose);
 

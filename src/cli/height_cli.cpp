@@ -40,13 +40,6 @@ glm::vec3 non_negative_rgb(const std::string& flag, const std::string& text) {
   return glm::vec3(c);
 }
 
-glm::vec3 finite_vector(const std::string& flag, const std::string& text) {
-  const glm::dvec3 v = parse_triple(flag, text);
-  for (int k = 0; k < 3; ++k)
-    if (!(std::isfinite(v[k]) && std::fabs(v[k]) <= 3.4e38)) throw Error(flag + " must be finite (got '" + text + "')");
-  return glm::vec3(v);
-}
-
 }  // namespace
 
 void add_height_options(CLI::App& app, HeightCliOptions& o) {
@@ -90,13 +83,7 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
       if (!given(flag))
         throw Error(std::string(flag) + " is required with --mode height (the camera pose X,Y,Z: --eye, --forward "
                     "and --up, or --camera-to-world with --axes)");
-    CameraPose p;
-    p.eye = finite_vector("--eye", ap.volumes.eye);
-    p.forward = finite_vector("--forward", ap.volumes.forward);
-    p.up = finite_vector("--up", ap.volumes.up);
-    if (p.forward == glm::vec3(0.0f))
-      throw Error("--forward must be a non-zero vector (got '" + ap.volumes.forward + "')");
-    if (p.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + ap.volumes.up + "')");
+    const CameraPose p = flag_pose(ap.volumes);
     if (detail::up_parallel_to_forward(p.up, p.forward))
       throw Error("--up must not be parallel to --forward (got --up '" + ap.volumes.up + "', --forward '" +
                   ap.volumes.forward + "')");
@@ -145,7 +132,7 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
       throw Error("--sun-color needs --light-dir (the direction toward the sun, X,Y,Z)");
     SunLobe sun;
     sun.color = non_negative_rgb("--sun-color", o.sun_color);
-    sun.direction = finite_vector("--light-dir", ap.volumes.light_dir);
+    sun.direction = parse_finite_vec3("--light-dir", ap.volumes.light_dir);
     if (sun.direction == glm::vec3(0.0f))
       throw Error("--light-dir must be a non-zero vector (got '" + ap.volumes.light_dir + "')");
     sun.direction = axes_to_fogcl(axes) * sun.direction;

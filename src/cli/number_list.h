@@ -2,6 +2,7 @@
 // flags share; each flag keeps its own count, range and messages.
 #pragma once
 
+#include <cmath>
 #include <cstdlib>
 #include <optional>
 #include <string>
@@ -60,6 +61,14 @@ inline glm::dvec3 parse_triple(const std::string& flag, const std::string& text,
   if (list.bad_part || list.numbers.size() != 3)
     throw Error(flag + " must be three comma-separated numbers " + names + " (got '" + text + "')");
   return {list.numbers[0], list.numbers[1], list.numbers[2]};
+}
+
+// "X,Y,Z" -> three finite floats, or "FLAG must be finite (got 'TEXT')" (as floats: 1e39 is inf).
+inline glm::vec3 parse_finite_vec3(const std::string& flag, const std::string& text) {
+  const glm::vec3 v(parse_triple(flag, text));
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(v[k])) throw Error(flag + " must be finite (got '" + text + "')");
+  return v;
 }
 
 }  // namespace fogcl::cli

@@ -395,14 +395,6 @@ std::string volumes_to_json(const std::vector<FogVolume>& volumes) {
 
 namespace {
 
-// "X,Y,Z" -> three finite floats, or an error naming the flag.
-glm::vec3 parse_vec3(const std::string& flag, const std::string& text) {
-  const glm::vec3 v(parse_triple(flag, text));
-  for (int k = 0; k < 3; ++k)  // as floats: 1e39 is inf
-    if (!std::isfinite(v[k])) throw Error(flag + " must be finite (got '" + text + "')");
-  return v;
-}
-
 const std::map<std::string, VolumeIntegrator> kIntegrators{{"stylized", VolumeIntegrator::stylized},
                                                            {"physical", VolumeIntegrator::physical}};
 const std::map<std::string, int> kResolutions{{"full", 1}, {"half", 2}, {"quarter", 4}};
@@ -571,11 +563,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
 
   // Camera pose and light, each checked with the flag's name before the library's own rules.
   if (!o.pose_per_frame) {
-    s.pose_.eye = parse_vec3("--eye", o.eye);
-    s.pose_.forward = parse_vec3("--forward", o.forward);
-    s.pose_.up = parse_vec3("--up", o.up);
-    if (s.pose_.forward == glm::vec3(0.0f)) throw Error("--forward must be a non-zero vector (got '" + o.forward + "')");
-    if (s.pose_.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + o.up + "')");
+    s.pose_ = flag_pose(o);
     try {
       validate(s.pose_);
     } catch (const Error& e) {
@@ -584,8 +572,8 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     s.pose_ = {to_fogcl * s.pose_.eye, to_fogcl * s.pose_.forward, to_fogcl * s.pose_.up};
     s.pose_from_ = std::string("--eye/--forward/--up") + (o.axes ? std::string(", --axes ") + to_string(axes) : "");
   }
-  s.light_.direction = parse_vec3("--light-dir", o.light_dir);
-  s.light_.color = parse_vec3("--light-color", o.light_color);
+  s.light_.direction = parse_finite_vec3("--light-dir", o.light_dir);
+  s.light_.color = parse_finite_vec3("--light-color", o.light_color);
   if (s.light_.direction == glm::vec3(0.0f))
     throw Error("--light-dir must be a non-zero vector (got '" + o.light_dir + "')");
   for (int k = 0; k < 3; ++k)

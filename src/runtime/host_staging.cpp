@@ -134,7 +134,6 @@ StagedFrame& StagedFrame::operator=(StagedFrame&& other) noexcept {
 
 StagedFrame::~StagedFrame() { release(); }
 
-
 // A frame given up before finish(): its commands may still use the slot's memory.
 void StagedFrame::release() {
   if (slot_ == nullptr) return;
@@ -249,47 +248,45 @@ void HostStaging::unmap(StagingSlot& s) {
 
 StagingSlot& HostStaging::take_slot(int width, int height, ColorFormat format) {
   std::lock_guard<std::mutex> lock(mutex_);
-  {
-    for (auto& s : slots_)
-      if (!s->busy && s->width == width && s->height == height && s->format == format) {
-        s->busy = true;
-        return *s;
-      }
-    const auto busy = std::count_if(slots_.begin(), slots_.end(), [](const auto& s) { return s->busy; });
-    if (busy >= kMaxInFlight)
-      throw Error("more than " + std::to_string(kMaxInFlight) +
-                  " staged frames in flight: wait() for earlier frames before starting more");
-    // A new size (or every slot busy): drop a free slot of another size first, keeping at most
-    // max_frames slots' memory.
-    if (int(slots_.size()) >= max_frames_) {
-      const auto idle = std::find_if(slots_.begin(), slots_.end(), [](const auto& s) { return !s->busy; });
-      if (idle != slots_.end()) {
-        unmap(**idle);
-        slots_.erase(idle);
-      }
+  for (auto& s : slots_)
+    if (!s->busy && s->width == width && s->height == height && s->format == format) {
+      s->busy = true;
+      return *s;
     }
-    auto s = std::make_unique<StagingSlot>();
-    s->width = width;
-    s->height = height;
-    s->format = format;
-    const std::size_t color = s->color_bytes(), depth = s->depth_bytes();
-    s->color_in = cl::Buffer(context_, CL_MEM_READ_WRITE, color);
-    s->depth = cl::Buffer(context_, CL_MEM_READ_ONLY, depth);
-    s->color_out = cl::Buffer(context_, CL_MEM_READ_WRITE, color);
-    s->pinned_in = cl::Buffer(context_, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR, color + depth);
-    s->pinned_out = cl::Buffer(context_, CL_MEM_WRITE_ONLY | CL_MEM_ALLOC_HOST_PTR, color);
-    s->in = static_cast<std::byte*>(upload_queue_.enqueueMapBuffer(s->pinned_in, CL_TRUE, CL_MAP_WRITE, 0, color + depth));
-    s->out = static_cast<std::byte*>(upload_queue_.enqueueMapBuffer(s->pinned_out, CL_TRUE, CL_MAP_READ, 0, color));
-    s->raw.width = width;
-    s->raw.height = height;
-    s->raw.format = format;
-    s->raw.color_in = s->color_in();
-    s->raw.depth = s->depth();
-    s->raw.color_out = s->color_out();
-    s->busy = true;
-    slots_.push_back(std::move(s));
-    return *slots_.back();
+  const auto busy = std::count_if(slots_.begin(), slots_.end(), [](const auto& s) { return s->busy; });
+  if (busy >= kMaxInFlight)
+    throw Error("more than " + std::to_string(kMaxInFlight) +
+                " staged frames in flight: wait() for earlier frames before starting more");
+  // A new size (or every slot busy): drop a free slot of another size first, keeping at most
+  // max_frames slots' memory.
+  if (int(slots_.size()) >= max_frames_) {
+    const auto idle = std::find_if(slots_.begin(), slots_.end(), [](const auto& s) { return !s->busy; });
+    if (idle != slots_.end()) {
+      unmap(**idle);
+      slots_.erase(idle);
+    }
   }
+  auto s = std::make_unique<StagingSlot>();
+  s->width = width;
+  s->height = height;
+  s->format = format;
+  const std::size_t color = s->color_bytes(), depth = s->depth_bytes();
+  s->color_in = cl::Buffer(context_, CL_MEM_READ_WRITE, color);
+  s->depth = cl::Buffer(context_, CL_MEM_READ_ONLY, depth);
+  s->color_out = cl::Buffer(context_, CL_MEM_READ_WRITE, color);
+  s->pinned_in = cl::Buffer(context_, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR, color + depth);
+  s->pinned_out = cl::Buffer(context_, CL_MEM_WRITE_ONLY | CL_MEM_ALLOC_HOST_PTR, color);
+  s->in = static_cast<std::byte*>(upload_queue_.enqueueMapBuffer(s->pinned_in, CL_TRUE, CL_MAP_WRITE, 0, color + depth));
+  s->out = static_cast<std::byte*>(upload_queue_.enqueueMapBuffer(s->pinned_out, CL_TRUE, CL_MAP_READ, 0, color));
+  s->raw.width = width;
+  s->raw.height = height;
+  s->raw.format = format;
+  s->raw.color_in = s->color_in();
+  s->raw.depth = s->depth();
+  s->raw.color_out = s->color_out();
+  s->busy = true;
+  slots_.push_back(std::move(s));
+  return *slots_.back();
 }
 
 // One image's bytes to a device buffer of the slot: where the image is pinned memory of this

@@ -137,9 +137,9 @@ class FogPass {
   // apply() that returns once `in` and `depth` are no longer needed, before `out` holds the
   // result (staged transfers: the upload, kernel and download are queued; the next call's upload
   // overlaps this one's download). `out` is sized here and must stay alive and untouched until
-  // the returned frame's wait(), which may run on another thread. Up to three frames in flight;
-  // a fourth call waits for the oldest's wait(). With direct transfers it is apply() and returns
-  // a finished frame.
+  // the returned frame's wait(), which may run on another thread. The staging of three frames in
+  // flight is kept; more get staging of their own, up to 16 in flight, then this throws
+  // fogcl::Error. With direct transfers it is apply() and returns a finished frame.
   PendingFrame apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                            const CameraParams& camera, const FogSettings& settings);
 
