@@ -363,7 +363,8 @@ def readme_speed(root):
     gpu = Bench(root, "gpu-h100/fog-gpu.json")
     march = Bench(root, "volume-local-2core/lanes-one-run.json")
     comp = Bench(root, "volume-composite-own-2026-11-24/fresh.json")
-    vgpu = Bench(root, "gpu-h100-2026-11-25-round-trip/volume-gpu.json")
+    vgpu = Bench(root, "gpu-h100-2026-11-26-final/volume-gpu.json")
+    rgpu = Bench(root, "gpu-h100-2026-11-26-final/fog-gpu.json")
     key = dict(w=1920, h=1080, mode=2, dist=0, f16=0)
     dev = d2.get("BM_OpenCLDevice", nt=2, **key)
     call = d2.get("BM_OpenCLHostCall", **key)
@@ -376,6 +377,8 @@ def readme_speed(root):
     mo = march.get("BM_VolumeOpenMP", integrator=0, width=1920)
     ck = comp.get("BM_VolumeCompositeKernel", f16=1, bilinear=0)
     vg = vgpu.get("BM_VolumeDevice", integrator=0, divisor=2, noise_image=1, width=1920)
+    rcall = rgpu.get("BM_OpenCLHostCall", **key)
+    rbus = rgpu.get("BM_PinnedTransfer", w=1920, h=1080, f16=0, host=1)
     _, sfps, _ = sequence_fps(root, "local-2core-2026-11-24/runs-baseline.json")
     _, xfps, _ = sequence_fps(root, "device-16core-2026-11-24/t16.json")
     gseq_rel = "gpu-h100-2026-11-25-round-trip/sequence-4k-48-frames.json"
@@ -407,6 +410,9 @@ def readme_speed(root):
          comp.date, src(comp.rel)],
         ["fog volumes, 1080p half, 64 steps, noise image (the GPU default), stylized", "H100", f(vg["real_time"]),
          f"target ≤ 1 ms", "met", vgpu.date, src(vgpu.rel)],
+        ["deferred fog, 1080p exp2 RGBA32F, whole host call from ordinary host images", "H100 (16-core Xeon host)",
+         f(rcall["real_time"]), f"the pinned transfer of its bytes (`BM_PinnedTransfer`), {f(rbus['real_time'])}",
+         f"{rcall['real_time'] / rbus['real_time']:.2f}× its time (target ≤ 1.5×)", rgpu.date, src(rgpu.rel)],
         ["`fogcl apply` sequence, 1080p float ZIP, 2 threads", "2-core EPYC", f"{s2[0]:.2f} frames/s",
          f"OpenEXR alone (read + write), {s2[1]:.2f} frames/s", f"{s2[0] / s2[1]:.2f}×", "2026-11-24",
          src("local-2core-2026-11-24/runs-baseline.json")],
@@ -419,7 +425,7 @@ def readme_speed(root):
     ]
     # The 2-vCPU Xeon (480 MiB L3), default settings (PoCL's threads floating); its ceiling is the
     # fastest of four copies of the row's bytes (ceiling_ms).
-    xe = Bench(root, "xeon-2core-readme-2026-11-25-late/fog.json")
+    xe = Bench(root, "xeon-2core-readme-2026-11-26/fog.json")
     xdev = xe.get("BM_OpenCLDevice", nt=2, **key)
     xcall = xe.get("BM_OpenCLHostCall", **key)
     xhal = xe.get("BM_Halide", **key)
@@ -436,6 +442,20 @@ def readme_speed(root):
          f"OpenMP + SIMD C++, {f(xomp['real_time'])}", f"{xomp['real_time'] / xdev['real_time']:.1f}× faster",
          xe.date, src(xe.rel)],
     ]
+    # Height fog (docs/DESIGN.md §6) on the same machine and run: bench modes 3 (a valley fog: grey,
+    # falloff) and 4 (a haze: per-channel, the sky fogged, a sun lobe).
+    hkey = dict(w=1920, h=1080, dist=0, f16=0)
+    for mode, what in ((3, "height fog, 1080p valley (grey, falloff) RGBA32F, device time"),
+                       (4, "height fog, 1080p haze (per-channel, sky fogged, sun lobe) RGBA32F, device time")):
+        hdev = xe.get("BM_OpenCLDevice", nt=2, mode=mode, **hkey)
+        homp = xe.get("BM_OpenMPSimd", mode=mode, **hkey)
+        rows.insert(6 + 2 * (mode - 3), [
+            what, xeon, f(hdev["real_time"]),
+            f"fastest 2-thread copy of the frame's bytes, {f(hdev['ceiling_ms'])}",
+            f"{hdev['vs_copy']:.2f}× its time (target ≥ 0.8×)", xe.date, src(xe.rel)])
+        rows.insert(7 + 2 * (mode - 3), [
+            "the same, device time", xeon, f(hdev["real_time"]), f"OpenMP + SIMD C++, same formulas, {f(homp['real_time'])}",
+            f"{homp['real_time'] / hdev['real_time']:.1f}× faster", xe.date, src(xe.rel)])
     header = ["what", "machine", "fogcl", "peer (or target)", "fogcl against it", "date", "result file"]
     return table(header, rows, ["---"] * 7).replace("](../bench/", "](bench/")
 
