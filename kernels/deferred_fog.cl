@@ -127,6 +127,9 @@
 #define FOG_HEIGHT_BITS (FOG_HB_FALLOFF | FOG_HB_RGB | FOG_HB_START | FOG_HB_CUTOFF | FOG_HB_MAX_OPACITY | \
                          FOG_HB_SUN | FOG_HB_SUN_START | FOG_HB_SAME_IN | (FOG_USE_SKYBOX ? FOG_HF_SKYBOX : 0))
 #endif
+#if FOG_VECTOR_WIDTH == 1
+#define FOG_DEVICE_EXP /* GPUs: height fog's e^x from the device (fog_math.h) */
+#endif
 #if FOG_VECTOR_WIDTH == 16
 #define FOG_CLAMP_BY_SELECT /* CPU devices: LLVM keeps IEEE comparisons (fog_sanitize_depth) */
 #endif
@@ -168,16 +171,36 @@ typedef struct {
 } FogConstants;
 
 /* One pixel (index i in the frame; color RGBA at 4 * i) as one vector load and store: GPUs, and
- * CPU devices' row tails. */
+ * CPU devices' row tails. GPUs read and write it through its aligned vector type (a buffer starts
+ * on CL_DEVICE_MEM_BASE_ADDR_ALIGN, at least 16 bytes), one memory instruction where vload4's
+ * element alignment gave NVIDIA four; CPU devices keep vload4: their buffers may be the caller's
+ * host memory, aligned to the element only. */
+#if FOG_VECTOR_WIDTH == 1
+#define FOG_PIXEL_BITS(p, i) (((global const ushort4*)(p))[i])
+#define FOG_PIXEL_BITS_OUT(p, i) (((global ushort4*)(p))[i])
+#else
+#define FOG_PIXEL_BITS(p, i) vload4((i), (global const ushort*)(p))
+#endif
 static inline float4 fog_load_pixel(global const COLOR_T* color, size_t i) {
-#ifdef FOG_COLOR_HALF
+#if FOG_VECTOR_WIDTH == 1 && defined(FOG_COLOR_HALF)
+  const ushort4 bits = FOG_PIXEL_BITS(color, i);
+  return vload_half4(0, (const half*)&bits);
+#elif FOG_VECTOR_WIDTH == 1
+  return ((global const float4*)color)[i];
+#elif defined(FOG_COLOR_HALF)
   return vload_half4(i, color);
 #else
   return vload4(i, color);
 #endif
 }
 static inline void fog_store_pixel(float4 o, global COLOR_T* color, size_t i) {
-#ifdef FOG_COLOR_HALF
+#if FOG_VECTOR_WIDTH == 1 && defined(FOG_COLOR_HALF)
+  ushort4 bits;
+  vstore_half4_rte(o, 0, (half*)&bits);
+  FOG_PIXEL_BITS_OUT(color, i) = bits;
+#elif FOG_VECTOR_WIDTH == 1
+  ((global float4*)color)[i] = o;
+#elif defined(FOG_COLOR_HALF)
   vstore_half4_rte(o, i, color);
 #else
   vstore4(o, i, color);
@@ -186,7 +209,11 @@ static inline void fog_store_pixel(float4 o, global COLOR_T* color, size_t i) {
 /* The pixel's bits unchanged: in half storage a half -> float -> half trip would quiet a
  * signalling NaN. */
 static inline void fog_copy_pixel(global const COLOR_T* color_in, global COLOR_T* color_out, size_t i) {
-#ifdef FOG_COLOR_HALF
+#if FOG_VECTOR_WIDTH == 1 && defined(FOG_COLOR_HALF)
+  FOG_PIXEL_BITS_OUT(color_out, i) = FOG_PIXEL_BITS(color_in, i);
+#elif FOG_VECTOR_WIDTH == 1
+  ((global float4*)color_out)[i] = ((global const float4*)color_in)[i];
+#elif defined(FOG_COLOR_HALF)
   vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
 #else
   vstore4(vload4(i, color_in), i, color_out);

@@ -477,10 +477,34 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_expm1_neg_poly)(FOG_REAL x) {
   FOG_NAME(fog_exp_expm1_neg_poly)(x, &expm1_x);
   return expm1_x;
 }
+#if defined(__OPENCL_C_VERSION__) && defined(FOG_DEVICE_EXP)
+/* e^x for x <= 0 whose result is budgeted absolutely (T, the lobe), from the device's exp2: the
+ * rounding of x log2(e) moves e^x by e^x |x| 2^-24 at most, under 2.2e-8 (e^x |x| <= 1/e). */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_neg_device)(FOG_REAL x) { return exp2(x * (FOG_REAL)0x1.715476p+0f); }
+/* fog_exp_expm1_neg_poly's contract from the device: e^x, 0 below -87, and e^x - 1 as T - 1, whose
+ * absolute error (T's plus half an ulp of 1) is what §6.3 budgets. */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_expm1_device)(FOG_REAL x, FOG_REAL* expm1_x) {
+  FOG_REAL t = x < (FOG_REAL)-87.0f ? (FOG_REAL)0 : FOG_NAME(fog_exp_neg_device)(x);
+  *expm1_x = t - (FOG_REAL)1;
+  return t;
+}
+#endif
 #ifdef __OPENCL_C_VERSION__
 #ifndef FOG_EXP
+#ifdef FOG_DEVICE_EXP
+/* GPUs (FOG_DEVICE_EXP): their exp and exp2 take a few instructions (NVIDIA: 2-12 against the
+ * polynomial's ~40) within the OpenCL spec's 3 ulp. T, J and the lobe are budgeted absolutely
+ * (docs/DESIGN.md §6.3: 4e-6), so 3 ulp of them, or J as T - 1, cost nothing of it; H's
+ * e^(-k h*) is relative: exp itself, 3 ulp against the 4e-6. G's expm1 and the lobe's log1p keep
+ * the polynomials: there the relative digits of small arguments matter. */
+#define FOG_EXP_EXPM1 FOG_NAME(fog_exp_expm1_device)
+#define FOG_EXP exp
+#define FOG_EXP_NEG FOG_NAME(fog_exp_neg_device)
+#else
 #define FOG_EXP_EXPM1 FOG_NAME(fog_exp_expm1_neg_poly)
 #define FOG_EXP FOG_NAME(fog_exp_poly)
+#define FOG_EXP_NEG FOG_NAME(fog_exp_poly)
+#endif
 #define FOG_EXPM1 FOG_NAME(fog_expm1_neg_poly)
 #define FOG_LOG1P FOG_NAME(fog_log1p_neg_poly)
 #endif
@@ -522,7 +546,7 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_depth)(FOG_REAL beta, FOG_REAL h) {
  * difference keeps the digits of small angles that a rounded cosine loses (e = 1000 near the
  * peak), and exp(e log1p(-q)) those of the power. 0 where cos θ <= 0 (q >= 1). */
 FOG_FN_INLINE FOG_REAL FOG_NAME(fog_sun_lobe)(FOG_REAL q, FOG_REAL e) {
-  return q < (FOG_REAL)1 ? FOG_EXP(e * FOG_LOG1P(-q)) : (FOG_REAL)0;
+  return q < (FOG_REAL)1 ? FOG_EXP_NEG(e * FOG_LOG1P(-q)) : (FOG_REAL)0;
 }
 
 /* 1 - cos(ω, ℓ) = |ω - ℓ|^2 / 2 for unit ω = (wx, wy, wz) and ℓ. */
@@ -546,7 +570,7 @@ FOG_FN_INLINE void FOG_NAME(fog_height_tj)(FOG_REAL h, FOG_REAL h_sun, const FOG
     *t = FOG_EXP_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h), j);
     *j = -*j;
   } else {
-    *t = FOG_EXP(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h));
+    *t = FOG_EXP_NEG(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h));
     *j = -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h));
   }
   *j_sun = (features & FOG_HF_SUN_START) ? -FOG_EXPM1(-FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_IN + c], h_sun))

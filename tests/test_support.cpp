@@ -28,11 +28,17 @@ namespace {
 struct RuntimeHolder {
   std::unique_ptr<Runtime> runtime;
   std::unique_ptr<FogPass> pass;
+  std::unique_ptr<FogPass> one_pixel_pass;  // CPU devices only
   std::string error;
   RuntimeHolder() {
     try {
       runtime = std::make_unique<Runtime>();
       pass = std::make_unique<FogPass>(*runtime);
+      if (runtime->is_cpu()) {
+        CpuCodegen one_pixel;
+        one_pixel.one_pixel_per_work_item = true;
+        one_pixel_pass = std::make_unique<FogPass>(*runtime, one_pixel);
+      }
     } catch (const std::exception& e) {
       error = e.what();
     }
@@ -47,6 +53,11 @@ RuntimeHolder& holder() {
 Runtime* runtime() { return holder().runtime.get(); }
 const std::string& runtime_error() { return holder().error; }
 FogPass& shared_pass() { return *holder().pass; }
+std::vector<KernelPath> kernel_paths() {
+  RuntimeHolder& h = holder();
+  if (!h.one_pixel_pass) return {{"device", h.pass.get(), false}};
+  return {{"blocks", h.pass.get(), true}, {"one pixel", h.one_pixel_pass.get(), false}};
+}
 
 TestFrame make_test_frame(int width, int height, bool reversed_z, ColorFormat format,
                           std::uint32_t seed, float avoid_distance) {

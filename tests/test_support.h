@@ -22,6 +22,15 @@ Runtime* runtime();
 const std::string& runtime_error();
 // One FogPass shared by the tests (its program cache makes each variant build once).
 FogPass& shared_pass();
+// The passes whose kernels a kernel test checks: shared_pass(), and on CPU devices also one that
+// builds the GPUs' one-pixel kernel (CpuCodegen::one_pixel_per_work_item), so that PoCL covers
+// the kernel text GPUs run. Each entry names its path ("blocks", "one pixel" or "device").
+struct KernelPath {
+  const char* name;
+  FogPass* pass;
+  bool is_cpu_blocks;  // PoCL's 16-pixel blocks: scalar<float>'s bits
+};
+std::vector<KernelPath> kernel_paths();
 
 #define FOGCL_REQUIRE_DEVICE()                                                        \
   do {                                                                                \

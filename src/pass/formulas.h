@@ -61,6 +61,7 @@ inline double fog_exp_expm1(double x, double* expm1_x) {
 #define FOG_AS_REAL fog_as_real
 #define FOG_EXP2 fog_exp2
 #define FOG_EXP fog_exp
+#define FOG_EXP_NEG fog_exp
 #define FOG_EXPM1 fog_expm1
 #define FOG_LOG1P fog_log1p
 #define FOG_EXP_EXPM1 fog_exp_expm1
@@ -69,6 +70,7 @@ inline double fog_exp_expm1(double x, double* expm1_x) {
 #include "fog_math.h"  // undefines the instance macros
 #undef FOG_EXP2
 #undef FOG_EXP
+#undef FOG_EXP_NEG
 #undef FOG_EXPM1
 #undef FOG_LOG1P
 #undef FOG_EXP_EXPM1

@@ -95,10 +95,12 @@ DeviceTraits device_traits(cl_device_id device, const CpuCodegen& codegen) {
   return traits;
 }
 
-int pixels_per_work_item(const DeviceTraits& device) { return device.cpu ? 16 : 1; }
+int pixels_per_work_item(const DeviceTraits& device) {
+  return device.cpu && !device.codegen.one_pixel_per_work_item ? 16 : 1;
+}
 
 long long streaming_min_pixels(const DeviceTraits& device) {
-  if (!device.cpu) return -1;  // GPUs: one pixel per work-item, their own store paths
+  if (pixels_per_work_item(device) == 1) return -1;  // GPUs' one pixel per work-item: their own stores
   switch (device.codegen.streaming_stores) {
     case CpuCodegen::Streaming::always: return 0;
     case CpuCodegen::Streaming::never: return -1;
@@ -149,7 +151,7 @@ std::string build_options(const Variant& v, const DeviceTraits& device) {
       if (v.height_features & n.bit) o += std::string(" -D FOG_HEIGHT_") + n.option;
   o += " -D FOG_VECTOR_WIDTH=" + std::to_string(pixels_per_work_item(device));
   o += streaming_store_option(device, v.storage);
-  if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
+  if (pixels_per_work_item(device) == 16 && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }
 

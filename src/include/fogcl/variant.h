@@ -78,6 +78,10 @@ struct CpuCodegen {
   // half conversions). false builds the portable OpenCL C path that other CPUs run, so that
   // tests on an AVX-512 machine cover it too.
   bool target_intrinsics = true;
+  // Build the kernel other devices (GPUs) run, one pixel per work-item, on this CPU device:
+  // for tests, so that PoCL checks that kernel text (its vector accesses, the device's exp in
+  // height fog) against the float64 reference where there is no GPU. Slower than the blocks.
+  bool one_pixel_per_work_item = false;
 };
 
 // What the build options depend on besides the scene.
