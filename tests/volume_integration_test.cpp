@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 #include "volume/volume_formulas.h"
 #include "volume_support.h"
@@ -71,6 +72,56 @@ TEST_F(VolumeIntegration, WaitsOnCallerEventsNeverBlocksAndMatchesTheConvenience
   const ColorImage got_in_place = read(in_place.color_out);
   EXPECT_EQ(std::memcmp(got_in_place.data(), expected.data(), got.size_bytes()), 0);
   EXPECT_EQ(pass.stats().noise_uploads, 1u) << "the noise texture is uploaded once and reused";
+}
+
+// The pass keeps its per-frame device scratch (constants, low-resolution march output) across
+// frames: frames in flight at once (more than the pool's sets, at two resolutions, with
+// different volumes) each get their own, and every output is what a fresh convenience call gives.
+TEST_F(VolumeIntegration, FramesInFlightKeepTheirOwnScratch) {
+  VolumePass pass(ctx(), runtime()->device());
+  constexpr int kFrames = 7;
+  std::vector<VolumeScene> scenes;
+  std::vector<VolumeSettings> frame_settings;
+  for (int i = 0; i < kFrames; ++i) {
+    VolumeScene sc = t.scene;
+    for (FogVolume& v : sc.volumes) {
+      v.center += glm::vec3(0.3f * float(i), 0.0f, 0.0f);
+      v.density *= 1.0f + 0.25f * float(i);
+    }
+    if (i % 3 == 2) sc.volumes.pop_back();  // fewer constants
+    VolumeSettings st = settings;
+    st.resolution_divisor = i % 2 == 0 ? 2 : 1;
+    pass.prepare(t.frame.params, sc, st, ColorFormat::rgba32f);
+    scenes.push_back(sc);
+    frame_settings.push_back(st);
+  }
+  const FrameBuffers fb = buffers(false);
+  std::vector<cl::Buffer> outs;
+  std::vector<cl::Event> done;
+  for (int round = 0; round < 2; ++round) {  // all in flight behind a gate, then one at a time
+    outs.clear();
+    done.clear();
+    cl::UserEvent gate(ctx);
+    for (int i = 0; i < kFrames; ++i) {
+      outs.emplace_back(ctx, CL_MEM_READ_WRITE, t.frame.color.size_bytes());
+      FrameBuffers f = fb;
+      f.color_out = outs.back()();
+      const std::vector<cl_event> waits = round == 0 ? std::vector<cl_event>{gate()} : std::vector<cl_event>{};
+      done.push_back(adopt(pass.enqueue(queue(), f, t.frame.params, scenes[std::size_t(i)],
+                                        frame_settings[std::size_t(i)], nullptr, waits)));
+      if (round == 1) done.back().wait();
+    }
+    gate.setStatus(CL_COMPLETE);
+    for (int i = 0; i < kFrames; ++i) {
+      done[std::size_t(i)].wait();
+      ColorImage expected;
+      VolumePass(*runtime()).apply(t.frame.color, t.frame.depth, expected, t.frame.params, scenes[std::size_t(i)],
+                                   frame_settings[std::size_t(i)]);
+      const ColorImage got = read(outs[std::size_t(i)]());
+      EXPECT_EQ(std::memcmp(got.data(), expected.data(), got.size_bytes()), 0) << "round " << round << ", frame " << i;
+    }
+  }
+  EXPECT_EQ(pass.stats().march_dispatches, 2u * kFrames);
 }
 
 TEST_F(VolumeIntegration, NothingVisibleMeansNoDispatchAndTheInputBitForBit) {
