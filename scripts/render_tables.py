@@ -234,17 +234,17 @@ def sequence_2core(root):
 
 
 def deferred_h100(root):
-    b = Bench(root, "gpu-h100/fog-gpu.json")
+    b = Bench(root, "gpu-h100-2026-11-26-device-exp/fog-gpu.json")
     rows = []
     for w, h, frame in FRAMES:
         row = [frame.replace("1080p", "1920×1080").replace("4K", "3840×2160")]
         for f16 in (0, 1):
-            dev = [b.get("BM_OpenCLDevice", w=w, h=h, mode=m, dist=d, f16=f16, nt=0) for m, d, _ in FOGS]
+            dev = [b.get("BM_OpenCLDevice", w=w, h=h, mode=m, dist=d, f16=f16, nt=2) for m, d, _ in FOGS]
             row += [rng([x["real_time"] for x in dev], lambda v: f"{v:.3f}"),
                     rng([x["bw_vs_copy"] for x in dev], ratio)]
         copy = [b.get("BM_DeviceCopy", w=w, h=h, f16=f16)["bytes_per_second"] / 1e9 for f16 in (0, 1)]
         trip = [rng([b.get("BM_OpenCLHostCall", w=w, h=h, mode=m, dist=d, f16=f16)["real_time"] for m, d, _ in FOGS],
-                    lambda v: f"{v:.0f}") for f16 in (0, 1)]
+                    lambda v: f"{v:.2f}") for f16 in (0, 1)]
         row += [f"{copy[0]:.0f} / {copy[1]:.0f}", f"{trip[0]} / {trip[1]}"]
         rows.append(row)
     header = ["frame", "RGBA32F device ms", "bw_vs_copy", "RGBA16F device ms", "bw_vs_copy", "copy GB/s (f32 / f16)",
@@ -255,7 +255,7 @@ def deferred_h100(root):
 
 
 def volume_h100(root):
-    b = Bench(root, "gpu-h100-after-lanes/gpu-volume.json")
+    b = Bench(root, "gpu-h100-2026-11-26-device-exp/volume-gpu.json")
     cases = [(2, 1, "half resolution, noise as an image (texture unit)", "≤ 1 ms"),
              (1, 1, "full resolution, noise as an image", "≤ 4 ms"),
              (2, 0, "half resolution, noise as a buffer (manual trilinear)", "≤ 1 ms"),
@@ -360,18 +360,18 @@ def volume_budget(root):
 def readme_speed(root):
     d2 = Bench(root, "local-2core-streaming/hostcall-halide-device-final.json")
     suite = Bench(root, "local-2core-streaming/fog.json")
-    gpu = Bench(root, "gpu-h100/fog-gpu.json")
+    gpu = Bench(root, "gpu-h100-2026-11-26-device-exp/fog-gpu.json")
     march = Bench(root, "volume-local-2core/lanes-one-run.json")
     comp = Bench(root, "volume-composite-own-2026-11-24/fresh.json")
-    vgpu = Bench(root, "gpu-h100-2026-11-26-final/volume-gpu.json")
-    rgpu = Bench(root, "gpu-h100-2026-11-26-final/fog-gpu.json")
+    vgpu = Bench(root, "gpu-h100-2026-11-26-device-exp/volume-gpu.json")
+    rgpu = Bench(root, "gpu-h100-2026-11-26-device-exp/fog-gpu.json")
     key = dict(w=1920, h=1080, mode=2, dist=0, f16=0)
     dev = d2.get("BM_OpenCLDevice", nt=2, **key)
     call = d2.get("BM_OpenCLHostCall", **key)
     hal = d2.get("BM_Halide", **key)
     omp = suite.get("BM_OpenMPSimd", **key)
     omp_cl = suite.get("BM_OpenCLDevice", nt=2, **key)
-    g = gpu.get("BM_OpenCLDevice", w=3840, h=2160, mode=2, dist=0, f16=0, nt=0)
+    g = gpu.get("BM_OpenCLDevice", w=3840, h=2160, mode=2, dist=0, f16=0, nt=2)
     gcopy = gpu.get("BM_DeviceCopy", w=3840, h=2160, f16=0)
     ml = march.get("BM_VolumeDevice", integrator=0, divisor=2, noise_image=0, width=1920)
     mo = march.get("BM_VolumeOpenMP", integrator=0, width=1920)
