@@ -48,7 +48,8 @@ struct VolumePass::Impl {
   VolumePassStats stats;
   std::string last_march_options, last_composite_options;
   // A frame's device scratch: the packed constants and the low-resolution march output, kept and
-  // reused across frames (allocating and releasing them cost NVIDIA ~0.2 ms a frame). A set is
+  // reused across frames (on NVIDIA their allocation, release and the first touch of fresh pages
+  // cost 0.3-0.4 ms a frame: docs/gpu.md). A set is
   // taken again once the composite that last read it is complete; while all kScratchSets are in
   // flight a frame gets buffers of its own, as it would without the pool (enqueue never blocks).
   struct Scratch {

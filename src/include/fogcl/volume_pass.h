@@ -47,7 +47,9 @@ float max_eye_depth(const DepthImage& depth, const CameraParams& camera);
 
 // Threads: a VolumePass is not thread-safe (kernel arguments, noise uploads): one per thread, or
 // lock around it. Passes may share one ProgramCache (thread-safe) with each other and with
-// FogPasses. It keeps its noise textures on the device across frames. Handles passed in are
+// FogPasses. It keeps its noise textures on the device across frames, and up to four frames'
+// scratch (the march's low-resolution output, 20 bytes a low-resolution pixel, and the frame's
+// constants), reused once the frame that last used it is complete. Handles passed in are
 // borrowed for the call, except the context and device of the constructor, which it retains.
 class VolumePass {
  public:
