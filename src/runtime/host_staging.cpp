@@ -3,6 +3,7 @@
 #include <sched.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstring>
 #include <map>
@@ -89,6 +90,12 @@ constexpr std::size_t kBandBytes = std::size_t(2) << 20;
 // A caller that never waits must not exhaust memory.
 constexpr long kMaxInFlight = 16;
 
+// The copies between the caller's memory and a band are split into chunks that the threads take
+// in order, so that all of them fill (or empty) the first band together and its DMA starts after
+// a chunk's worth of time per thread. One thread per band made every band finish at once: at
+// 1080p RGBA16F (8 bands, 8 threads) the color crossed the bus only after all of it was copied.
+constexpr std::size_t kChunkBytes = std::size_t(256) << 10;
+
 struct Band {
   std::size_t offset, bytes;
 };
@@ -97,6 +104,17 @@ std::vector<Band> bands(std::size_t total) {
   const std::size_t per = ((total + n - 1) / n + 4095) / 4096 * 4096;  // page multiples
   std::vector<Band> out;
   for (std::size_t at = 0; at < total; at += per) out.push_back({at, std::min(per, total - at)});
+  return out;
+}
+// A band's chunks, band by band in order: `band` indexes the bands.
+struct Chunk {
+  std::size_t band, offset, bytes;
+};
+std::vector<Chunk> chunks(const std::vector<Band>& in_bands) {
+  std::vector<Chunk> out;
+  for (std::size_t b = 0; b < in_bands.size(); ++b)
+    for (std::size_t at = 0; at < in_bands[b].bytes; at += kChunkBytes)
+      out.push_back({b, in_bands[b].offset + at, std::min(kChunkBytes, in_bands[b].bytes - at)});
   return out;
 }
 }  // namespace
@@ -303,11 +321,18 @@ void HostStaging::upload_image(const std::byte* src, std::size_t bytes, const cl
     return;
   }
   const std::vector<Band> image_bands = bands(bytes);
+  const std::vector<Chunk> image_chunks = chunks(image_bands);
   std::vector<cl::Event> done(image_bands.size());
-  up_workers_.run(int(image_bands.size()), [&](int i) {
-    const Band b = image_bands[i];
-    band_copy(pinned + b.offset, src + b.offset, b.bytes);
-    upload_queue_.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done[i]);
+  // Chunks not yet copied per band: the thread that copies a band's last one sends the band.
+  std::vector<std::atomic<std::size_t>> left(image_bands.size());
+  for (std::atomic<std::size_t>& n : left) n.store(0, std::memory_order_relaxed);
+  for (const Chunk& c : image_chunks) left[c.band].fetch_add(1, std::memory_order_relaxed);
+  up_workers_.run(int(image_chunks.size()), [&](int i) {
+    const Chunk c = image_chunks[i];
+    band_copy(pinned + c.offset, src + c.offset, c.bytes);
+    if (left[c.band].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+    const Band b = image_bands[c.band];
+    upload_queue_.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done[c.band]);
   });
   if (events) events->insert(events->end(), done.begin(), done.end());
 }
@@ -359,12 +384,14 @@ void HostStaging::finish(StagedFrame& frame, ColorImage& out) {
   if (!frame) return;
   StagingSlot& s = *frame.slot_;
   if (s.downloads.empty()) throw Error("HostStaging::finish: the frame's download was never enqueued");
-  const std::vector<Band> color_bands = bands(s.color_bytes());
+  const std::vector<Chunk> color_chunks = chunks(bands(s.color_bytes()));
   auto* dst = static_cast<std::byte*>(out.data());
-  // Band b is copied out as soon as its DMA is done, while later bands still cross the bus.
-  down_workers_.run(int(color_bands.size()), [&](int b) {
-    s.downloads[b].wait();
-    if (!s.out_direct) band_copy(dst + color_bands[b].offset, s.out + color_bands[b].offset, color_bands[b].bytes);
+  // A band is copied out, chunk by chunk by every thread, as soon as its DMA is done, while later
+  // bands still cross the bus.
+  down_workers_.run(int(color_chunks.size()), [&](int i) {
+    const Chunk c = color_chunks[i];
+    s.downloads[c.band].wait();
+    if (!s.out_direct) band_copy(dst + c.offset, s.out + c.offset, c.bytes);
   });
   frame.release();
 }
