@@ -234,7 +234,7 @@ def sequence_2core(root):
 
 
 def deferred_h100(root):
-    b = Bench(root, "gpu-h100-2026-11-26-device-exp/fog-gpu.json")
+    b = Bench(root, "gpu-h100-2026-11-26-chunks/fog-gpu.json")
     rows = []
     for w, h, frame in FRAMES:
         row = [frame.replace("1080p", "1920×1080").replace("4K", "3840×2160")]
@@ -255,7 +255,7 @@ def deferred_h100(root):
 
 
 def volume_h100(root):
-    b = Bench(root, "gpu-h100-2026-11-26-device-exp/volume-gpu.json")
+    b = Bench(root, "gpu-h100-2026-11-26-chunks/volume-gpu.json")
     cases = [(2, 1, "half resolution, noise as an image (texture unit)", "≤ 1 ms"),
              (1, 1, "full resolution, noise as an image", "≤ 4 ms"),
              (2, 0, "half resolution, noise as a buffer (manual trilinear)", "≤ 1 ms"),
@@ -360,11 +360,11 @@ def volume_budget(root):
 def readme_speed(root):
     d2 = Bench(root, "local-2core-streaming/hostcall-halide-device-final.json")
     suite = Bench(root, "local-2core-streaming/fog.json")
-    gpu = Bench(root, "gpu-h100-2026-11-26-device-exp/fog-gpu.json")
+    gpu = Bench(root, "gpu-h100-2026-11-26-chunks/fog-gpu.json")
     march = Bench(root, "volume-local-2core/lanes-one-run.json")
     comp = Bench(root, "volume-composite-own-2026-11-24/fresh.json")
-    vgpu = Bench(root, "gpu-h100-2026-11-26-device-exp/volume-gpu.json")
-    rgpu = Bench(root, "gpu-h100-2026-11-26-device-exp/fog-gpu.json")
+    vgpu = Bench(root, "gpu-h100-2026-11-26-chunks/volume-gpu.json")
+    rgpu = Bench(root, "gpu-h100-2026-11-26-chunks/fog-gpu.json")
     key = dict(w=1920, h=1080, mode=2, dist=0, f16=0)
     dev = d2.get("BM_OpenCLDevice", nt=2, **key)
     call = d2.get("BM_OpenCLHostCall", **key)
