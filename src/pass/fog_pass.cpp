@@ -287,7 +287,7 @@ PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage&
                                                                 const detail::HostStaging::UploadColor& upload_color) {
     done = adopt(dispatch(queue, fb, v, camera, settings, {upload_color()()}));
     queue.flush();
-    return done;
+    return std::vector<detail::HostStaging::RowsReady>{{fb.height, done}};
   });
   ++stats.copied_frames;
   PendingFrame pending;

@@ -128,7 +128,8 @@ struct StagingSlot {
   std::byte* in = nullptr;                // pinned_in: color, then depth
   std::byte* out = nullptr;               // pinned_out: color
   FrameBuffers raw;
-  cl::Event uploaded, after;              // after: the passes' last event (download())
+  cl::Event uploaded;
+  std::vector<cl::Event> after;           // the passes' events that the download follows
   std::vector<cl::Event> depth_ready;     // the depth's transfers, sent before the color
   std::vector<cl::Event> downloads;       // one per band of color_out
   bool out_direct = false;                // downloaded into the caller's pinned image itself
@@ -159,7 +160,7 @@ void StagedFrame::release() {
   try {
     for (cl::Event& e : s->depth_ready) e.wait();
     if (s->uploaded()) s->uploaded.wait();
-    if (s->after()) s->after.wait();
+    for (cl::Event& e : s->after) e.wait();
     for (cl::Event& e : s->downloads) e.wait();
   } catch (...) {
     // A failed command is over, too: the slot can be reused.
@@ -246,7 +247,7 @@ void HostStaging::give_back(StagingSlot* slot) {
   std::lock_guard<std::mutex> lock(mutex_);
   slot->busy = false;
   slot->uploaded = cl::Event();
-  slot->after = cl::Event();
+  slot->after.clear();
   slot->depth_ready.clear();
   slot->downloads.clear();
   slot->out_direct = false;
@@ -357,21 +358,31 @@ StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, Co
     upload_queue_.flush();
     return s.uploaded;
   };
-  const cl::Event after = passes(s.raw, s.depth_ready, upload_color);
+  const std::vector<RowsReady> ready = passes(s.raw, s.depth_ready, upload_color);
   if (!color_sent) upload_color();  // every frame sends its color: `uploaded` ends the upload
   // The caller may change its images once this returns: the DMA from them must be over.
   if (color_direct || depth_direct) s.uploaded.wait();
-  download(frame, after, out);
+  download(frame, ready, out);
   return frame;
 }
 
-void HostStaging::download(StagedFrame& frame, const cl::Event& after, ColorImage& out) {
+void HostStaging::download(StagedFrame& frame, const std::vector<RowsReady>& ready, ColorImage& out) {
   StagingSlot& s = *frame.slot_;
-  s.after = after;
-  const std::vector<cl::Event> wait{after};
+  if (ready.empty() || ready.back().rows_end != s.height)
+    throw Error("HostStaging: the passes' rows do not end at the frame's last row");
+  for (const RowsReady& r : ready) s.after.push_back(r.event);
   auto* dst = static_cast<std::byte*>(out.data());
   s.out_direct = is_pinned(dst, s.color_bytes(), context_());
+  const std::size_t row_bytes = s.color_bytes() / std::size_t(s.height);
   for (const Band& b : bands(s.color_bytes())) {
+    // The band waits for the passes' events of the rows it holds.
+    const int first = int(b.offset / row_bytes), last = int((b.offset + b.bytes - 1) / row_bytes);
+    std::vector<cl::Event> wait;
+    int begin = 0;
+    for (const RowsReady& r : ready) {
+      if (r.rows_end > first && begin <= last) wait.push_back(r.event);
+      begin = r.rows_end;
+    }
     cl::Event e;
     download_queue_.enqueueReadBuffer(s.color_out, CL_FALSE, b.offset, b.bytes, (s.out_direct ? dst : s.out) + b.offset,
                                       &wait, &e);

@@ -102,13 +102,20 @@ class HostStaging {
   // passes(buffers, depth_ready, upload_color) enqueues the passes on the slot's device buffers:
   // what reads only the depth after depth_ready, then calls upload_color(), which sends the color
   // up and returns the event after which color and depth are on the device, and enqueues the rest
-  // after it; it returns the passes' last event, which the download of buffers.color_out into
-  // `out` follows. Returns once the host images may be reused (the DMA from the slot may still
-  // run); an image in pinned memory of this context (pinned_memory.h) crosses the bus from where
-  // it is, uncopied (then this waits for that DMA).
+  // after it; it returns when which rows of buffers.color_out are final (RowsReady, one entry
+  // for the whole frame or one per band of rows), which the download into `out` follows band by
+  // band. Returns once the host images may be reused (the DMA from the slot may still run); an
+  // image in pinned memory of this context (pinned_memory.h) crosses the bus from where it is,
+  // uncopied (then this waits for that DMA).
   using UploadColor = std::function<cl::Event()>;
-  using Passes = std::function<cl::Event(const FrameBuffers& buffers, const std::vector<cl::Event>& depth_ready,
-                                         const UploadColor& upload_color)>;
+  // Rows [the previous entry's rows_end, rows_end) of the output are final once `event` is
+  // complete; entries in ascending order, the last one ending at the frame's height.
+  struct RowsReady {
+    int rows_end;
+    cl::Event event;
+  };
+  using Passes = std::function<std::vector<RowsReady>(
+      const FrameBuffers& buffers, const std::vector<cl::Event>& depth_ready, const UploadColor& upload_color)>;
   StagedFrame start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes);
   // Waits for the download and copies it into `out` (the image given to start()); then the slot
   // is free for the next frame. Thread-safe against start() of other frames.
@@ -117,7 +124,7 @@ class HostStaging {
  private:
   void upload_image(const std::byte* src, std::size_t bytes, const cl::Buffer& to, std::byte* pinned, bool& direct,
                     std::vector<cl::Event>* events);
-  void download(StagedFrame& frame, const cl::Event& after, ColorImage& out);
+  void download(StagedFrame& frame, const std::vector<RowsReady>& ready, ColorImage& out);
   friend class StagedFrame;
   void give_back(StagingSlot* slot);
   void unmap(StagingSlot& slot);

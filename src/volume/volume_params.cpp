@@ -401,7 +401,7 @@ int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
   // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
   // work-items, which the march's loops prevent; the lanes instance has no image sampling.
   const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
-  return device.cpu && buffer ? 16 : 1;
+  return pixels_per_work_item(device) == 16 && buffer ? 16 : 1;
 }
 
 std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& device) {

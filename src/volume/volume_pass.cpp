@@ -59,6 +59,8 @@ struct VolumePass::Impl {
     cl::Event done;                               // the last composite that read the set
   };
   static constexpr std::size_t kScratchSets = 4;
+  // Bands of rows of a staged call's march and composite on GPUs (enqueue_frame's rows).
+  static constexpr std::size_t kRowBands = 4;
   std::vector<Scratch> scratch;
   // A free set sized for `f`, its constants' writes enqueued on `queue` (their events appended to
   // `writes`), or nullptr when every set is in flight.
@@ -101,11 +103,15 @@ struct VolumePass::Impl {
                                     std::vector<cl::Event>& waits);
   // VolumePass::enqueue's work after `waits`. after_march (may be empty) runs once the march is
   // enqueued and flushed (the march reads the depth, not the color) and returns what the
-  // composite waits for besides the march: the staged call sends the color up there.
+  // composite waits for besides the march: the staged call sends the color up there. rows (the
+  // staged call; `queue` in order): on devices of one pixel per work-item the march and the
+  // composite go in bands of rows, interleaved, and rows gets when each band of the output is
+  // final, so that its download follows while the march goes on; else one entry.
   using AfterMarch = std::function<std::vector<cl::Event>()>;
   cl::Event enqueue_frame(const cl::CommandQueue& queue, const FrameBuffers& fb, const CameraParams& camera,
                           const VolumeScene& scene, const VolumeSettings& requested, const ShadowMapBuffer* shadow,
-                          std::vector<cl::Event> waits, const AfterMarch& after_march, float max_eye);
+                          std::vector<cl::Event> waits, const AfterMarch& after_march, float max_eye,
+                          std::vector<detail::HostStaging::RowsReady>* rows = nullptr);
   // `settings` with its noise sampling resolved for this device: what the variant, its build
   // options and the noise upload are chosen from.
   VolumeSettings resolved(const VolumeSettings& settings) const {
@@ -115,7 +121,8 @@ struct VolumePass::Impl {
   }
 };
 
-VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs)
+VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs,
+                       const CpuCodegen& codegen)
     : impl_(std::make_unique<Impl>()) {
   if (context == nullptr || device == nullptr)
     throw Error("VolumePass needs a context and a device (got a null handle)");
@@ -126,7 +133,7 @@ VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<
   if (programs->context() != context)
     throw Error("VolumePass: the shared ProgramCache belongs to another OpenCL context than the pass");
   m.programs = std::move(programs);
-  m.traits = device_traits(device);
+  m.traits = device_traits(device, codegen);
   m.images = with_cl_errors([&] { return m.device.getInfo<CL_DEVICE_IMAGE_SUPPORT>() == CL_TRUE; });
   m.noise_device.cpu = m.traits.cpu;
   m.noise_device.images = m.images;
@@ -140,8 +147,8 @@ VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<
     });
 }
 
-VolumePass::VolumePass(const Runtime& runtime, std::shared_ptr<ProgramCache> programs)
-    : VolumePass(runtime.context(), runtime.device(), std::move(programs)) {
+VolumePass::VolumePass(const Runtime& runtime, std::shared_ptr<ProgramCache> programs, const CpuCodegen& codegen)
+    : VolumePass(runtime.context(), runtime.device(), std::move(programs), codegen) {
   impl_->queue = wrap(runtime.queue());
 }
 
@@ -262,7 +269,7 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
                                           const CameraParams& camera, const VolumeScene& scene,
                                           const VolumeSettings& requested, const ShadowMapBuffer* shadow,
                                           std::vector<cl::Event> waits, const AfterMarch& after_march,
-                                          float max_eye) {
+                                          float max_eye, std::vector<detail::HostStaging::RowsReady>* rows) {
   Impl& m = *this;
   const VolumeSettings settings = m.resolved(requested);
   const detail::PackedVolumeFrame f =
@@ -295,6 +302,7 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
       queue.enqueueCopyBuffer(wrap(fb.color_in), wrap(fb.color_out), 0, 0,
                               color_buffer_bytes(fb.width, fb.height, fb.format), waits.empty() ? nullptr : &waits,
                               &done);
+    if (rows != nullptr) rows->push_back({fb.height, done});
     return done;
   }
   const std::string march_options = detail::volume_march_options(f.variant, m.traits);
@@ -339,29 +347,67 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   march.setArg(arg++, cl_uint(scene.frame_index));
   march.setArg(arg++, low);
   march.setArg(arg++, low_key);
-  cl::Event marched;
   const int march_lanes = detail::volume_march_lanes(f.variant, m.traits);  // target pixels per work-item
-  queue.enqueueNDRangeKernel(march, cl::NullRange,
-                             march_entry.shape.global(std::size_t((f.low_width + march_lanes - 1) / march_lanes),
-                                                      std::size_t(f.low_height)),
-                             march_entry.shape.local(), waits.empty() ? nullptr : &waits, &marched);
-  ++m.stats.march_dispatches;
+  const std::size_t march_x = std::size_t((f.low_width + march_lanes - 1) / march_lanes);
+  const auto global = detail::volume_composite_global(f.variant, m.traits, fb.width, fb.height);
   composite.setArg(0, wrap(fb.color_in));
   composite.setArg(1, depth);
   composite.setArg(2, wrap(fb.color_out));
   composite.setArg(3, frame);
   composite.setArg(4, low);
   composite.setArg(5, low_key);
-  std::vector<cl::Event> after{marched};
-  if (after_march) {
-    queue.flush();  // the march may start while after_march works
-    const std::vector<cl::Event> more = after_march();
-    after.insert(after.end(), more.begin(), more.end());
+  // Bands: whole work-groups of target rows, frame rows `scale` times as many. Composite band i
+  // reads target rows up to the first of band i + 1 (the upsampling's 2 x 2 taps), so the queue
+  // runs march 0, march 1, composite 0, march 2, composite 1, ...
+  const std::size_t low_height = std::size_t(f.low_height), scale = std::size_t(f.variant.scale);
+  std::size_t band_rows = low_height;
+  if (rows != nullptr && march_lanes == 1 && global[1] == std::size_t(fb.height)) {
+    const std::size_t group = std::max(march_entry.shape.y, composite_entry.shape.y);
+    band_rows = std::max(group, ((low_height + kRowBands - 1) / kRowBands + group - 1) / group * group);
   }
-  const auto global = detail::volume_composite_global(f.variant, m.traits, fb.width, fb.height);
-  queue.enqueueNDRangeKernel(composite, cl::NullRange, composite_entry.shape.global(global[0], global[1]),
-                             composite_entry.shape.local(), &after, &done);
-  ++m.stats.composite_dispatches;
+  const std::size_t bands = (low_height + band_rows - 1) / band_rows;
+  if (bands == 1) {
+    cl::Event marched;
+    queue.enqueueNDRangeKernel(march, cl::NullRange, march_entry.shape.global(march_x, low_height),
+                               march_entry.shape.local(), waits.empty() ? nullptr : &waits, &marched);
+    ++m.stats.march_dispatches;
+    std::vector<cl::Event> after{marched};
+    if (after_march) {
+      queue.flush();  // the march may start while after_march works
+      const std::vector<cl::Event> more = after_march();
+      after.insert(after.end(), more.begin(), more.end());
+    }
+    queue.enqueueNDRangeKernel(composite, cl::NullRange, composite_entry.shape.global(global[0], global[1]),
+                               composite_entry.shape.local(), &after, &done);
+    ++m.stats.composite_dispatches;
+    if (rows != nullptr) rows->push_back({fb.height, done});
+  } else {
+    const auto march_band = [&](std::size_t b, const std::vector<cl::Event>* wait) {
+      const std::size_t first = b * band_rows;
+      queue.enqueueNDRangeKernel(march, cl::NDRange(0, first),
+                                 march_entry.shape.global(march_x, std::min(band_rows, low_height - first)),
+                                 march_entry.shape.local(), wait);
+      ++m.stats.march_dispatches;
+    };
+    march_band(0, waits.empty() ? nullptr : &waits);
+    march_band(1, nullptr);
+    std::vector<cl::Event> after;
+    if (after_march) {
+      queue.flush();
+      after = after_march();
+    }
+    for (std::size_t b = 0; b < bands; ++b) {
+      const std::size_t first = b * band_rows * scale;
+      const std::size_t end = std::min((b + 1) * band_rows * scale, std::size_t(fb.height));
+      queue.enqueueNDRangeKernel(composite, cl::NDRange(0, first),
+                                 composite_entry.shape.global(global[0], end - first), composite_entry.shape.local(),
+                                 b == 0 && !after.empty() ? &after : nullptr, &done);
+      ++m.stats.composite_dispatches;
+      rows->push_back({int(end), done});
+      if (b + 2 < bands) march_band(b + 2, nullptr);
+      queue.flush();  // the band's download waits for it on another queue
+    }
+  }
   if (scratch_set != nullptr) scratch_set->done = done;
   return done;
 }
@@ -410,11 +456,11 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
           staging.start(in, depth, out, [&](const FrameBuffers& fb, const std::vector<cl::Event>& depth_ready,
                                             const detail::HostStaging::UploadColor& upload_color) {
             // The march reads the depth only: it runs while the color is sent up.
-            const cl::Event done = m.enqueue_frame(
-                m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, depth_ready,
-                [&] { return std::vector<cl::Event>{upload_color()}; }, max_eye);
+            std::vector<detail::HostStaging::RowsReady> rows;
+            m.enqueue_frame(m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, depth_ready,
+                            [&] { return std::vector<cl::Event>{upload_color()}; }, max_eye, &rows);
             m.queue.flush();
-            return done;
+            return rows;
           });
       staging.finish(staged, out);
       return;

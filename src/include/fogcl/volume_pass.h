@@ -55,9 +55,12 @@ class VolumePass {
  public:
   // Integration: programs are built for `device` in the caller's `context`, in `programs` when
   // given (a cache of the same context), else in a cache of its own.
-  VolumePass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs = nullptr);
+  // codegen: how CPU devices' kernels are built (CpuCodegen, variant.h; the tests' knob).
+  VolumePass(cl_context context, cl_device_id device, std::shared_ptr<ProgramCache> programs = nullptr,
+             const CpuCodegen& codegen = {});
   // Convenience: the runtime's context, device and queue.
-  explicit VolumePass(const Runtime& runtime, std::shared_ptr<ProgramCache> programs = nullptr);
+  explicit VolumePass(const Runtime& runtime, std::shared_ptr<ProgramCache> programs = nullptr,
+                      const CpuCodegen& codegen = {});
   ~VolumePass();
   VolumePass(VolumePass&&) noexcept;
   VolumePass& operator=(VolumePass&&) noexcept;
