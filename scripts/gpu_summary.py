@@ -123,16 +123,18 @@ if fog:
         rt = host.get((a["w"], a["mode"], a["dist"], a["f16"]))
         fmt = "f16" if a["f16"] == "1" else "f32"
         ratio = b.get("bw_vs_copy", float("nan"))
-        if a["w"] == "3840":
-            worst[fmt] = min(worst.get(fmt, 9e9), ratio)
+        if a["w"] == "3840":  # Unity's modes against 0.8 of the copy, height fog against 0.9
+            group = "height fog" if MODES[a["mode"]].startswith("height") else "linear, exp, exp2"
+            worst[(group, fmt)] = min(worst.get((group, fmt), 9e9), ratio)
         p(f'| {a["w"]}x{a["h"]} | {MODES[a["mode"]]} | {"distance" if a["dist"] == "1" else "depth"} | {fmt} '
           f'| {ms(b):.4f} | {b["bytes_per_second"] / 1e9:.0f} '
           f'| {copy["bytes_per_second"] / 1e9 if copy else float("nan"):.0f} | {ratio:.2f} '
           f'| {ms(rt) if rt else float("nan"):.2f} | {b.get("max_err", float("nan")):.2g} |')
     p()
-    for fmt, r in sorted(worst.items()):
-        verdict = "met" if r >= 0.8 else "FAILED"
-        line = f"4K device-resident {fmt}: worst bw_vs_copy {r:.2f} (target >= 0.8): {verdict}"
+    for (group, fmt), r in sorted(worst.items()):
+        target = 0.9 if group == "height fog" else 0.8
+        verdict = "met" if r >= target else "FAILED"
+        line = f"4K device-resident {group} {fmt}: worst bw_vs_copy {r:.2f} (target >= {target}): {verdict}"
         p(line if verdict == "met" else "FAILED: " + line)
     for b in fog:
         if re.match(r"BM_(DispatchOverhead|FirstDispatch|ProgramBuild)", b["base"]):
