@@ -67,9 +67,9 @@ void run(const Channel* in, const float* depth, Channel* out, int w, int h, cons
 
 // Height fog (docs/DESIGN.md §6): the same formulas per pixel, kFeatures (fog_math.h FOG_HF_*) and,
 // with kRawPerspective, the camera's kind (raw depth, conventional Z, perspective) compile-time
-// constants as in the kernel, so that the row's loop has no branch and GCC vectorises it (-1 / false:
-// runtime values, for scenes the benchmark does not time); one loop over the row (the channels are
-// not separable).
+// constants as in the kernel, so that the row's loop has no branch on them (-1 / false: runtime
+// values, for scenes the benchmark does not time); one loop over the row (the channels are not
+// separable). GCC still keeps that loop scalar (docs/performance.md, height fog).
 template <int kFeatures, bool kRawPerspective, class Channel>
 void run_height(const Channel* in, const float* depth, Channel* out, int w, int h, const CameraParams& cam,
                 const detail::HeightCoefficients<float>& k, int threads, int runtime_features = 0) {

@@ -174,49 +174,38 @@ typedef struct {
  * CPU devices' row tails. GPUs read and write it through its aligned vector type (a buffer starts
  * on CL_DEVICE_MEM_BASE_ADDR_ALIGN, at least 16 bytes), one memory instruction where vload4's
  * element alignment gave NVIDIA four; CPU devices keep vload4: their buffers may be the caller's
- * host memory, aligned to the element only. */
+ * host memory, aligned to the element only. T: the element type. */
 #if FOG_VECTOR_WIDTH == 1
-#define FOG_PIXEL_BITS(p, i) (((global const ushort4*)(p))[i])
-#define FOG_PIXEL_BITS_OUT(p, i) (((global ushort4*)(p))[i])
+#define FOG_LOAD4(T, p, i) (((global const T##4*)(p))[i])
+#define FOG_STORE4(T, v, p, i) (((global T##4*)(p))[i] = (v))
 #else
-#define FOG_PIXEL_BITS(p, i) vload4((i), (global const ushort*)(p))
+#define FOG_LOAD4(T, p, i) vload4((i), (global const T*)(p))
+#define FOG_STORE4(T, v, p, i) vstore4((v), (i), (global T*)(p))
 #endif
 static inline float4 fog_load_pixel(global const COLOR_T* color, size_t i) {
-#if FOG_VECTOR_WIDTH == 1 && defined(FOG_COLOR_HALF)
-  const ushort4 bits = FOG_PIXEL_BITS(color, i);
+#ifdef FOG_COLOR_HALF
+  const ushort4 bits = FOG_LOAD4(ushort, color, i);
   return vload_half4(0, (const half*)&bits);
-#elif FOG_VECTOR_WIDTH == 1
-  return ((global const float4*)color)[i];
-#elif defined(FOG_COLOR_HALF)
-  return vload_half4(i, color);
 #else
-  return vload4(i, color);
+  return FOG_LOAD4(float, color, i);
 #endif
 }
 static inline void fog_store_pixel(float4 o, global COLOR_T* color, size_t i) {
-#if FOG_VECTOR_WIDTH == 1 && defined(FOG_COLOR_HALF)
+#ifdef FOG_COLOR_HALF
   ushort4 bits;
   vstore_half4_rte(o, 0, (half*)&bits);
-  FOG_PIXEL_BITS_OUT(color, i) = bits;
-#elif FOG_VECTOR_WIDTH == 1
-  ((global float4*)color)[i] = o;
-#elif defined(FOG_COLOR_HALF)
-  vstore_half4_rte(o, i, color);
+  FOG_STORE4(ushort, bits, color, i);
 #else
-  vstore4(o, i, color);
+  FOG_STORE4(float, o, color, i);
 #endif
 }
 /* The pixel's bits unchanged: in half storage a half -> float -> half trip would quiet a
  * signalling NaN. */
 static inline void fog_copy_pixel(global const COLOR_T* color_in, global COLOR_T* color_out, size_t i) {
-#if FOG_VECTOR_WIDTH == 1 && defined(FOG_COLOR_HALF)
-  FOG_PIXEL_BITS_OUT(color_out, i) = FOG_PIXEL_BITS(color_in, i);
-#elif FOG_VECTOR_WIDTH == 1
-  ((global float4*)color_out)[i] = ((global const float4*)color_in)[i];
-#elif defined(FOG_COLOR_HALF)
-  vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
+#ifdef FOG_COLOR_HALF
+  FOG_STORE4(ushort, FOG_LOAD4(ushort, color_in, i), color_out, i);
 #else
-  vstore4(vload4(i, color_in), i, color_out);
+  FOG_STORE4(uint, FOG_LOAD4(uint, color_in, i), color_out, i);
 #endif
 }
 

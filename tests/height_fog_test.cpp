@@ -261,20 +261,36 @@ TEST_P(HeightKernelVsReference, WithinBudget) {
   const Frame f = make_frame(47, 31, cam, c.format, 1234u + unsigned(GetParam()));
   ColorImage scalar_out;
   apply_fog_scalar(f.color, f.depth, scalar_out, cam, s);
+  const Variant v = select_variant(s, cam, c.format);
+  ASSERT_EQ(v.mode, KernelMode::height);
+  // The library's double path is these formulas: the same bits.
+  const FogResult<double> ref = fog_scalar<double>(f.color, f.depth, cam, s);
+  for (int y = 0; y < f.color.height(); y += 5)
+    for (int x = 0; x < f.color.width(); x += 3) {
+      const PixelEval e = eval_pixel(f.color, f.depth, cam, s, v, x, y);
+      for (int k = 0; k < 3; ++k)
+        ASSERT_EQ(e.rgb[k], ref.rgba[4 * (std::size_t(y) * f.color.width() + x) + k]) << x << "," << y;
+    }
+  // Half storage: the output's own rounding on top (one half ulp of the reference).
+  const auto half_ulps = [&](const ColorImage& img) {
+    Check h;
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x)
+        for (int k = 0; k < 3; ++k) {
+          const double r = ref.rgba[4 * (std::size_t(y) * img.width() + x) + k];
+          const double err = std::fabs(double(img.pixel(x, y)[k]) - r);
+          h.worst_err = std::max(h.worst_err, std::isnan(err) ? INFINITY : err / half_ulp(r));
+        }
+    h.worst_excess = h.worst_err;
+    return h;
+  };
+  const Check sc = c.format == ColorFormat::rgba16f ? half_ulps(scalar_out)
+                                                    : check_image(scalar_out, f.color, f.depth, cam, s, v);
   for (const KernelPath& path : kernel_paths()) {
     FogPass& pass = *path.pass;
     ColorImage out;
     pass.apply(f.color, f.depth, out, cam, s);
-    const Variant v = pass.last_variant();
-    ASSERT_EQ(v.mode, KernelMode::height);
-    // The library's double path is these formulas: the same bits.
-    const FogResult<double> ref = fog_scalar<double>(f.color, f.depth, cam, s);
-    for (int y = 0; y < f.color.height(); y += 5)
-      for (int x = 0; x < f.color.width(); x += 3) {
-        const PixelEval e = eval_pixel(f.color, f.depth, cam, s, v, x, y);
-        for (int k = 0; k < 3; ++k)
-          ASSERT_EQ(e.rgb[k], ref.rgba[4 * (std::size_t(y) * f.color.width() + x) + k]) << x << "," << y;
-      }
+    ASSERT_EQ(pass.last_variant(), v);
     // PoCL's CPU blocks run the same operations as scalar<float> (fma where written, IEEE
     // selects): the same bits, whichever of its 16-lane blocks or one-pixel row tails a pixel is
     // in. The GPUs' one-pixel kernel takes the device's exp (fog_math.h, FOG_DEVICE_EXP): budgets.
@@ -285,25 +301,8 @@ TEST_P(HeightKernelVsReference, WithinBudget) {
     if (same_bits_expected) {
       EXPECT_EQ(differing, 0u) << "kernel vs scalar<float> bits";
     }
-    Check kc = check_image(out, f.color, f.depth, cam, s, v);
-    Check sc = check_image(scalar_out, f.color, f.depth, cam, s, v);
-    // Half storage: the output's own rounding on top (one half ulp of the reference).
-    const auto half_ulps = [&](const ColorImage& img) {
-      Check h;
-      for (int y = 0; y < img.height(); ++y)
-        for (int x = 0; x < img.width(); ++x)
-          for (int k = 0; k < 3; ++k) {
-            const double r = ref.rgba[4 * (std::size_t(y) * img.width() + x) + k];
-            const double err = std::fabs(double(img.pixel(x, y)[k]) - r);
-            h.worst_err = std::max(h.worst_err, std::isnan(err) ? INFINITY : err / half_ulp(r));
-          }
-      h.worst_excess = h.worst_err;
-      return h;
-    };
-    if (c.format == ColorFormat::rgba16f) {  // in half ulps of the reference
-      kc = half_ulps(out);
-      sc = half_ulps(scalar_out);
-    }
+    const Check kc = c.format == ColorFormat::rgba16f ? half_ulps(out)  // in half ulps of the reference
+                                                      : check_image(out, f.color, f.depth, cam, s, v);
     std::printf("[ worst    ] %-44s %-9s %-60s kernel: err %.2e excess %.2e (allow %.1e) | scalar<float>: err %.2e excess %.2e | %zu floats differ\n",
                 c.name, path.name, describe(v).c_str(), kc.worst_err, kc.worst_excess, kc.worst_allow, sc.worst_err,
                 sc.worst_excess, differing);
@@ -566,22 +565,23 @@ TEST(HeightFog, ExtremeCasesWithinBudget) {
       for (int x = 0; x < w; ++x) depth.at(x, y) = e.distance;
     double worst = 0, worst_allow = 0;
     std::size_t nonfinite = 0;
-    for (const KernelPath& path : kernel_paths())
-      for (const float value : {0.0f, 1.0f, 100.0f}) {
-        const ColorImage color = probe_color(w, h, ColorFormat::rgba32f, value);
+    const Variant v = select_variant(s, cam, ColorFormat::rgba32f);
+    for (const float value : {0.0f, 1.0f, 100.0f}) {
+      const ColorImage color = probe_color(w, h, ColorFormat::rgba32f, value);
+      ColorImage scalar_out;
+      apply_fog_scalar(color, depth, scalar_out, cam, s);
+      const Check sc = check_image(scalar_out, color, depth, cam, s, v);
+      worst = std::max(worst, sc.worst_excess);
+      nonfinite += sc.nonfinite;
+      for (const KernelPath& path : kernel_paths()) {
         ColorImage out;
         path.pass->apply(color, depth, out, cam, s);
-        const Variant v = path.pass->last_variant();
-        const Check c = check_image(out, color, depth, cam, s, v);
+        const Check c = check_image(out, color, depth, cam, s, path.pass->last_variant());
         worst = std::max(worst, c.worst_excess);
         worst_allow = std::max(worst_allow, c.worst_allow);
         nonfinite += c.nonfinite;
-        ColorImage scalar_out;
-        apply_fog_scalar(color, depth, scalar_out, cam, s);
-        const Check sc = check_image(scalar_out, color, depth, cam, s, v);
-        worst = std::max(worst, sc.worst_excess);
-        nonfinite += sc.nonfinite;
       }
+    }
     std::printf("[ extreme  ] %-46s excess over allowance %.2e (allowance up to %.1e)\n", e.name, worst, worst_allow);
     EXPECT_EQ(nonfinite, 0u) << e.name;
     EXPECT_LE(worst, kBudget) << e.name;

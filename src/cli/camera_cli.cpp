@@ -187,10 +187,8 @@ CameraPose renderer_pose(const CameraCliOptions& o, const ExrInput& color, std::
 CameraPose flag_pose(const VolumeCliOptions& v) {
   CameraPose p;
   p.eye = parse_finite_vec3("--eye", v.eye);
-  p.forward = parse_finite_vec3("--forward", v.forward);
-  p.up = parse_finite_vec3("--up", v.up);
-  if (p.forward == glm::vec3(0.0f)) throw Error("--forward must be a non-zero vector (got '" + v.forward + "')");
-  if (p.up == glm::vec3(0.0f)) throw Error("--up must be a non-zero vector (got '" + v.up + "')");
+  p.forward = parse_direction("--forward", v.forward);
+  p.up = parse_direction("--up", v.up);
   return p;
 }
 

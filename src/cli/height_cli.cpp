@@ -132,9 +132,7 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
       throw Error("--sun-color needs --light-dir (the direction toward the sun, X,Y,Z)");
     SunLobe sun;
     sun.color = non_negative_rgb("--sun-color", o.sun_color);
-    sun.direction = parse_finite_vec3("--light-dir", ap.volumes.light_dir);
-    if (sun.direction == glm::vec3(0.0f))
-      throw Error("--light-dir must be a non-zero vector (got '" + ap.volumes.light_dir + "')");
+    sun.direction = parse_direction("--light-dir", ap.volumes.light_dir);
     sun.direction = axes_to_fogcl(axes) * sun.direction;
     if (given("--sun-exponent")) {
       const double e = parse_number("--sun-exponent", o.sun_exponent);

@@ -71,4 +71,11 @@ inline glm::vec3 parse_finite_vec3(const std::string& flag, const std::string& t
   return v;
 }
 
+// parse_finite_vec3, and not (0, 0, 0): "FLAG must be a non-zero vector (got 'TEXT')" (a direction).
+inline glm::vec3 parse_direction(const std::string& flag, const std::string& text) {
+  const glm::vec3 v = parse_finite_vec3(flag, text);
+  if (v == glm::vec3(0.0f)) throw Error(flag + " must be a non-zero vector (got '" + text + "')");
+  return v;
+}
+
 }  // namespace fogcl::cli

@@ -572,10 +572,8 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     s.pose_ = {to_fogcl * s.pose_.eye, to_fogcl * s.pose_.forward, to_fogcl * s.pose_.up};
     s.pose_from_ = std::string("--eye/--forward/--up") + (o.axes ? std::string(", --axes ") + to_string(axes) : "");
   }
-  s.light_.direction = parse_finite_vec3("--light-dir", o.light_dir);
+  s.light_.direction = parse_direction("--light-dir", o.light_dir);
   s.light_.color = parse_finite_vec3("--light-color", o.light_color);
-  if (s.light_.direction == glm::vec3(0.0f))
-    throw Error("--light-dir must be a non-zero vector (got '" + o.light_dir + "')");
   for (int k = 0; k < 3; ++k)
     if (s.light_.color[k] < 0.0f)
       throw Error("--light-color must be >= 0 in each channel (got '" + o.light_color + "')");

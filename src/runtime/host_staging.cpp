@@ -310,8 +310,8 @@ StagingSlot& HostStaging::take_slot(int width, int height, ColorFormat format) {
 
 // One image's bytes to a device buffer of the slot: where the image is pinned memory of this
 // context, straight from it (then `direct` is set); else band by band through the slot's pinned
-// memory at `pinned`, each band's DMA enqueued by the thread that filled it as soon as it is
-// filled. The transfers' events are appended to `events` (may be null).
+// memory at `pinned`, each band's DMA enqueued by the thread that copies its last chunk. The
+// transfers' events are appended to `events` (may be null).
 void HostStaging::upload_image(const std::byte* src, std::size_t bytes, const cl::Buffer& to, std::byte* pinned,
                                bool& direct, std::vector<cl::Event>* events) {
   direct = is_pinned(src, bytes, context_());
@@ -326,8 +326,8 @@ void HostStaging::upload_image(const std::byte* src, std::size_t bytes, const cl
   std::vector<cl::Event> done(image_bands.size());
   // Chunks not yet copied per band: the thread that copies a band's last one sends the band.
   std::vector<std::atomic<std::size_t>> left(image_bands.size());
-  for (std::atomic<std::size_t>& n : left) n.store(0, std::memory_order_relaxed);
-  for (const Chunk& c : image_chunks) left[c.band].fetch_add(1, std::memory_order_relaxed);
+  for (std::size_t b = 0; b < image_bands.size(); ++b)
+    left[b].store((image_bands[b].bytes + kChunkBytes - 1) / kChunkBytes, std::memory_order_relaxed);
   up_workers_.run(int(image_chunks.size()), [&](int i) {
     const Chunk c = image_chunks[i];
     band_copy(pinned + c.offset, src + c.offset, c.bytes);

@@ -6,8 +6,9 @@
 // device buffers and pinned host memory (CL_MEM_ALLOC_HOST_PTR, mapped once: NVIDIA's pinned
 // allocation), kept and reused across calls. The caller's pixels are copied into the pinned memory
 // by a few threads taking small chunks in order, each band's DMA enqueued as soon as its bytes are
-// there, so the copy and the transfer overlap; the download mirrors it. Up to `max_frames` frames may be in flight
-// (upload of one, kernels of the next, download of a third: the sequence pipeline's overlap).
+// there, so the copy and the transfer overlap; the download mirrors it. Up to `max_frames` frames
+// may be in flight (upload of one, kernels of the next, download of a third: the sequence
+// pipeline's overlap).
 // CPU devices do not come here: the kernel reads the host images in place (frame_buffers.h).
 #pragma once
 

@@ -49,12 +49,11 @@ struct VolumePass::Impl {
   std::string last_march_options, last_composite_options;
   // A frame's device scratch: the packed constants and the low-resolution march output, kept and
   // reused across frames (on NVIDIA their allocation, release and the first touch of fresh pages
-  // cost 0.3-0.4 ms a frame: docs/gpu.md). A set is
-  // taken again once the composite that last read it is complete; while all kScratchSets are in
-  // flight a frame gets buffers of its own, as it would without the pool (enqueue never blocks).
+  // cost 0.3-0.4 ms a frame: docs/gpu.md). A set is taken again once the composite that last read
+  // it is complete; while all kScratchSets are in flight a frame gets buffers of its own, as it
+  // would without the pool (enqueue never blocks).
   struct Scratch {
     cl::Buffer frame, volumes, low, low_key;
-    std::size_t frame_bytes = 0, volume_bytes = 0, low_bytes = 0, low_key_bytes = 0;
     std::vector<float> frame_host, volumes_host;  // the writes' sources, kept until `done`
     cl::Event done;                               // the last composite that read the set
   };
@@ -243,16 +242,13 @@ VolumePass::Impl::Scratch* VolumePass::Impl::take_scratch(const cl::CommandQueue
     s = &scratch.emplace_back();
   }
   const std::size_t low_pixels = std::size_t(f.low_width) * std::size_t(f.low_height);
-  const auto fit = [&](cl::Buffer& b, std::size_t& have, std::size_t need, cl_mem_flags flags) {
-    if (have < need) {
-      b = cl::Buffer(context, flags, need);
-      have = need;
-    }
+  const auto fit = [&](cl::Buffer& b, std::size_t need, cl_mem_flags flags) {
+    if (b() == nullptr || b.getInfo<CL_MEM_SIZE>() < need) b = cl::Buffer(context, flags, need);
   };
-  fit(s->frame, s->frame_bytes, f.frame.size() * sizeof(float), CL_MEM_READ_ONLY);
-  fit(s->volumes, s->volume_bytes, f.volumes.size() * sizeof(float), CL_MEM_READ_ONLY);
-  fit(s->low, s->low_bytes, low_pixels * 4 * sizeof(float), CL_MEM_READ_WRITE);
-  fit(s->low_key, s->low_key_bytes, low_pixels * sizeof(float), CL_MEM_READ_WRITE);
+  fit(s->frame, f.frame.size() * sizeof(float), CL_MEM_READ_ONLY);
+  fit(s->volumes, f.volumes.size() * sizeof(float), CL_MEM_READ_ONLY);
+  fit(s->low, low_pixels * 4 * sizeof(float), CL_MEM_READ_WRITE);
+  fit(s->low_key, low_pixels * sizeof(float), CL_MEM_READ_WRITE);
   s->frame_host.assign(f.frame.begin(), f.frame.end());
   s->volumes_host.assign(f.volumes.begin(), f.volumes.end());
   cl::Event e;
@@ -356,9 +352,10 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   composite.setArg(3, frame);
   composite.setArg(4, low);
   composite.setArg(5, low_key);
-  // Bands: whole work-groups of target rows, frame rows `scale` times as many. Composite band i
-  // reads target rows up to the first of band i + 1 (the upsampling's 2 x 2 taps), so the queue
-  // runs march 0, march 1, composite 0, march 2, composite 1, ...
+  // Bands (rows: staged calls on devices of one pixel per work-item; else one band): whole
+  // work-groups of target rows, frame rows `scale` times as many. Composite band b reads target
+  // rows up to the first of band b + 1 (the upsampling's 2 x 2 taps): it waits for marches up to
+  // b + 1, and the queue runs march 0, march 1, composite 0, march 2, composite 1, ...
   const std::size_t low_height = std::size_t(f.low_height), scale = std::size_t(f.variant.scale);
   std::size_t band_rows = low_height;
   if (rows != nullptr && march_lanes == 1 && global[1] == std::size_t(fb.height)) {
@@ -366,47 +363,33 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
     band_rows = std::max(group, ((low_height + kRowBands - 1) / kRowBands + group - 1) / group * group);
   }
   const std::size_t bands = (low_height + band_rows - 1) / band_rows;
-  if (bands == 1) {
-    cl::Event marched;
-    queue.enqueueNDRangeKernel(march, cl::NullRange, march_entry.shape.global(march_x, low_height),
-                               march_entry.shape.local(), waits.empty() ? nullptr : &waits, &marched);
+  std::vector<cl::Event> marched(bands);
+  const auto march_band = [&](std::size_t b) {
+    const std::size_t first = b * band_rows;
+    queue.enqueueNDRangeKernel(march, cl::NDRange(0, first),
+                               march_entry.shape.global(march_x, std::min(band_rows, low_height - first)),
+                               march_entry.shape.local(), b == 0 && !waits.empty() ? &waits : nullptr, &marched[b]);
     ++m.stats.march_dispatches;
-    std::vector<cl::Event> after{marched};
-    if (after_march) {
-      queue.flush();  // the march may start while after_march works
-      const std::vector<cl::Event> more = after_march();
-      after.insert(after.end(), more.begin(), more.end());
-    }
-    queue.enqueueNDRangeKernel(composite, cl::NullRange, composite_entry.shape.global(global[0], global[1]),
+  };
+  march_band(0);
+  if (bands > 1) march_band(1);
+  std::vector<cl::Event> uploaded;
+  if (after_march) {
+    queue.flush();  // the march may start while after_march works
+    uploaded = after_march();
+  }
+  for (std::size_t b = 0; b < bands; ++b) {
+    const std::size_t first = b * band_rows * scale;
+    const std::size_t end = b + 1 == bands ? std::size_t(fb.height) : (b + 1) * band_rows * scale;
+    std::vector<cl::Event> after = uploaded;
+    after.insert(after.end(), marched.begin(), marched.begin() + std::min(b + 2, bands));
+    queue.enqueueNDRangeKernel(composite, cl::NDRange(0, first),
+                               composite_entry.shape.global(global[0], b + 1 == bands ? global[1] - first : end - first),
                                composite_entry.shape.local(), &after, &done);
     ++m.stats.composite_dispatches;
-    if (rows != nullptr) rows->push_back({fb.height, done});
-  } else {
-    const auto march_band = [&](std::size_t b, const std::vector<cl::Event>* wait) {
-      const std::size_t first = b * band_rows;
-      queue.enqueueNDRangeKernel(march, cl::NDRange(0, first),
-                                 march_entry.shape.global(march_x, std::min(band_rows, low_height - first)),
-                                 march_entry.shape.local(), wait);
-      ++m.stats.march_dispatches;
-    };
-    march_band(0, waits.empty() ? nullptr : &waits);
-    march_band(1, nullptr);
-    std::vector<cl::Event> after;
-    if (after_march) {
-      queue.flush();
-      after = after_march();
-    }
-    for (std::size_t b = 0; b < bands; ++b) {
-      const std::size_t first = b * band_rows * scale;
-      const std::size_t end = std::min((b + 1) * band_rows * scale, std::size_t(fb.height));
-      queue.enqueueNDRangeKernel(composite, cl::NDRange(0, first),
-                                 composite_entry.shape.global(global[0], end - first), composite_entry.shape.local(),
-                                 b == 0 && !after.empty() ? &after : nullptr, &done);
-      ++m.stats.composite_dispatches;
-      rows->push_back({int(end), done});
-      if (b + 2 < bands) march_band(b + 2, nullptr);
-      queue.flush();  // the band's download waits for it on another queue
-    }
+    if (rows != nullptr) rows->push_back({int(end), done});
+    if (b + 2 < bands) march_band(b + 2);
+    if (bands > 1) queue.flush();  // the band's download waits for it on another queue
   }
   if (scratch_set != nullptr) scratch_set->done = done;
   return done;
