@@ -49,7 +49,9 @@ class KernelVsReference : public ::testing::TestWithParam<Param> {};
 
 TEST_P(KernelVsReference, WithinBudget) {
   FOGCL_REQUIRE_DEVICE();
-  const auto [mode, distance, skybox, reversed, format, size] = GetParam();
+  const auto [mode, distance, skybox, reversed, format_, size] = GetParam();
+  // A copy, not the binding: lambdas may not capture structured bindings before C++20.
+  const ColorFormat format = format_;
   const TestFrame& t = frame(size.first, size.second, reversed, format);
   const FogSettings s = settings_for(mode, distance, skybox);
 
