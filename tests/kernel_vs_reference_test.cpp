@@ -49,9 +49,9 @@ class KernelVsReference : public ::testing::TestWithParam<Param> {};
 
 TEST_P(KernelVsReference, WithinBudget) {
   FOGCL_REQUIRE_DEVICE();
-  const auto [mode, distance, skybox, reversed, format_, size] = GetParam();
-  // A copy, not the binding: lambdas may not capture structured bindings before C++20.
-  const ColorFormat format = format_;
+  const auto [mode, distance, skybox, reversed, format, size] = GetParam();
+  // A variable of its own (lambdas may not capture structured bindings before C++20).
+  const bool f32 = format == ColorFormat::rgba32f;
   const TestFrame& t = frame(size.first, size.second, reversed, format);
   const FogSettings s = settings_for(mode, distance, skybox);
 
@@ -63,10 +63,10 @@ TEST_P(KernelVsReference, WithinBudget) {
   // storage would round f itself).
   FogSettings probe = s;
   probe.color = glm::vec3(0.0f);
-  const ColorImage white = format == ColorFormat::rgba32f ? white_like(t.color) : ColorImage();
+  const ColorImage white = f32 ? white_like(t.color) : ColorImage();
   std::optional<FogResult<double>> fref;
   double cf = 0;
-  if (format == ColorFormat::rgba32f) {
+  if (f32) {
     ColorImage cp;
     apply_fog_scalar(white, t.depth, cp, t.params, probe);
     fref = fog_scalar<double>(white, t.depth, t.params, probe);
@@ -76,7 +76,7 @@ TEST_P(KernelVsReference, WithinBudget) {
   const auto expect_within_budget = [&](const ErrorStats& e, double factor_err, const char* path) {
     EXPECT_EQ(e.nonfinite_from_finite, 0u) << path;
     EXPECT_LE(factor_err, kFactorBudget) << path;
-    if (format == ColorFormat::rgba32f)
+    if (f32)
       EXPECT_LE(e.max_rel, kColorRelBudget) << path;
     else
       EXPECT_LE(e.max_half_ulps_beyond_factor, kHalfUlpBudget) << path;

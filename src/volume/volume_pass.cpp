@@ -101,12 +101,12 @@ struct VolumePass::Impl {
   const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
                                     std::vector<cl::Event>& waits);
   // VolumePass::enqueue's work after `waits`. after_march (may be empty) runs once the march is
-  // enqueued and flushed (the march reads the depth, not the color) and returns what the
+  // enqueued and flushed (the march reads the depth, not the color) and returns the event the
   // composite waits for besides the march: the staged call sends the color up there. rows (the
   // staged call; `queue` in order): on devices of one pixel per work-item the march and the
   // composite go in bands of rows, interleaved, and rows gets when each band of the output is
   // final, so that its download follows while the march goes on; else one entry.
-  using AfterMarch = std::function<std::vector<cl::Event>()>;
+  using AfterMarch = detail::HostStaging::UploadColor;
   cl::Event enqueue_frame(const cl::CommandQueue& queue, const FrameBuffers& fb, const CameraParams& camera,
                           const VolumeScene& scene, const VolumeSettings& requested, const ShadowMapBuffer* shadow,
                           std::vector<cl::Event> waits, const AfterMarch& after_march, float max_eye,
@@ -288,10 +288,7 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
     m.last_march_options.clear();
     m.last_composite_options.clear();
     ++m.stats.frames_without_volumes;
-    if (after_march) {
-      const std::vector<cl::Event> more = after_march();
-      waits.insert(waits.end(), more.begin(), more.end());
-    }
+    if (after_march) waits.push_back(after_march());
     if (fb.color_out == fb.color_in)
       queue.enqueueMarkerWithWaitList(waits.empty() ? nullptr : &waits, &done);
     else
@@ -376,7 +373,7 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   std::vector<cl::Event> uploaded;
   if (after_march) {
     queue.flush();  // the march may start while after_march works
-    uploaded = after_march();
+    uploaded.push_back(after_march());
   }
   for (std::size_t b = 0; b < bands; ++b) {
     const std::size_t first = b * band_rows * scale;
@@ -440,8 +437,8 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
                                             const detail::HostStaging::UploadColor& upload_color) {
             // The march reads the depth only: it runs while the color is sent up.
             std::vector<detail::HostStaging::RowsReady> rows;
-            m.enqueue_frame(m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, depth_ready,
-                            [&] { return std::vector<cl::Event>{upload_color()}; }, max_eye, &rows);
+            m.enqueue_frame(m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, depth_ready, upload_color,
+                            max_eye, &rows);
             m.queue.flush();
             return rows;
           });
