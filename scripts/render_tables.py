@@ -424,7 +424,7 @@ def readme_speed(root):
     ]
     # The 2-vCPU Xeon (480 MiB L3), default settings (PoCL's threads floating); its ceiling is the
     # fastest of four copies of the row's bytes (ceiling_ms).
-    xe = Bench(root, "xeon-2core-readme-2026-11-26b/fog.json")
+    xe = Bench(root, "xeon-2core-readme-2026-11-26c/fog.json")
     xdev = xe.get("BM_OpenCLDevice", nt=2, **key)
     xcall = xe.get("BM_OpenCLHostCall", **key)
     xhal = xe.get("BM_Halide", **key)
