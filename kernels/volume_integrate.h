@@ -141,8 +141,9 @@ VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL
 
 /* The extinction [1/world] and the albedo-weighted light of the volumes of `mask` at p, t:
  * sigma_t = density * field * fades per volume, summed; *source = sum of sigma_t * albedo * L with
- * L = light * phase * shadow + ambient. A volume adds where its bit is set (a per-lane select). */
-VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, VOL_REAL cos_theta, VOL_REAL lit, VOL_UINT mask,
+ * L = light * phase[i] * shadow + ambient, phase[i] volume i's phase function along the ray (one
+ * value per ray: vol_physical_phases). A volume adds where its bit is set (a per-lane select). */
+VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, const VOL_REAL* phase, VOL_REAL lit, VOL_UINT mask,
                                     VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
                                     VOL_NOISE_PARAM, int noise_size, int features, VOL_V3* source) {
   const VOL_U3 light = VOL_PU3(frame, VOL_F_LIGHT_COLOR);
@@ -156,7 +157,7 @@ VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, VOL_REAL cos_theta, VO
     if ((features & VOL_FEATURE_NOISE) && VOL_PU(vol, VOL_V_NOISE) != (VOL_U)0)
       sigma *= vol_density_field(vol, p, time, noise, noise_size, features & VOL_FEATURE_DETAIL);
     if (features & VOL_FEATURE_FADES) sigma *= vol_fades(vol, p, t);
-    const VOL_REAL phase_lit = vol_phase_hg(cos_theta, VOL_PU(vol, VOL_V_ANISOTROPY)) * lit;
+    const VOL_REAL phase_lit = phase[i] * lit;
     const VOL_U3 albedo = VOL_PU3(vol, VOL_V_ALBEDO), ambient = VOL_PU3(vol, VOL_V_AMBIENT);
     s_r = in ? s_r + albedo.x * (light.x * phase_lit + ambient.x) * sigma : s_r;
     s_g = in ? s_g + albedo.y * (light.y * phase_lit + ambient.y) * sigma : s_g;
@@ -165,6 +166,12 @@ VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, VOL_REAL cos_theta, VO
   }
   *source = VOL_MAKE3(s_r, s_g, s_b);
   return sigma_t;
+}
+
+/* physical: each volume's phase function along a ray of cos_theta to the light, in phase[0, count)
+ * (constant along the ray: computed once, not per sample). */
+VOL_FN void vol_physical_phases(VOL_REAL cos_theta, VOL_GLOBAL const float* vols, int count, VOL_REAL* phase) {
+  for (int i = 0; i < count; ++i) phase[i] = vol_phase_hg(cos_theta, VOL_PU(vols + i * VOL_V_STRIDE, VOL_V_ANISOTROPY));
 }
 
 /* physical: the weight of a segment of length seg with extinction sigma_t > 0 after optical
@@ -256,7 +263,8 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
   const VOL_UINT hit = vol_physical_hits(origin, dir, t_scene, vols, count, t_in, t_out, &start);
   VOL_REAL i_r = 0, i_g = 0, i_b = 0, depth = 0;
   if (hit == 0u) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
-  const VOL_REAL cos_theta = dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR));
+  VOL_REAL phase[VOL_MAX_VOLUMES];
+  vol_physical_phases(dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR)), vols, count, phase);
   const VOL_REAL covered = vol_covered(t_in, t_out, hit, count, start);
   VOL_REAL a = start;
   for (int piece = 0; piece < 2 * count; ++piece) {
@@ -275,7 +283,7 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
                                  ? vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)
                                  : (VOL_REAL)1;
         VOL_V3 source;
-        const VOL_REAL sigma_t = vol_physical_sample(p, t, cos_theta, lit, mask, vols, count, frame, noise,
+        const VOL_REAL sigma_t = vol_physical_sample(p, t, phase, lit, mask, vols, count, frame, noise,
                                                      noise_size, features, &source);
         if (!(sigma_t > (VOL_REAL)0)) continue;
         const VOL_REAL scatter = vol_segment_weight(sigma_t, seg, depth, riemann);

@@ -287,7 +287,8 @@ kernel void volume_march(global const float* depth, global const float* frame, g
                                                           &mask[k], &n[k], &pieces[k]);
     live[k] = first ? -1 : 0;
   }
-  const float16 cos16 = vload16(0, cos_theta);
+  float16 phase[VOL_MAX_VOLUMES];
+  vol_physical_phases(vload16(0, cos_theta), volumes, count, phase);
   float16 i_r = 0.0f, i_g = 0.0f, i_b = 0.0f, optical = 0.0f;
   for (;;) {
     const int16 alive = vload16(0, live);
@@ -304,7 +305,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
       lit = vol_shadow_lit(p, frame, shadow_map, VOL_FEATURES & VOL_FEATURE_SHADOW_REVERSED);
     vol_float3x16 source;
     const uint16 volumes_here = alive ? vload16(0, mask) : (uint16)0u;
-    const float16 sigma_t = vol_physical_sample(p, t, cos16, lit, volumes_here, volumes, count, frame, noise,
+    const float16 sigma_t = vol_physical_sample(p, t, phase, lit, volumes_here, volumes, count, frame, noise,
                                                 noise_size, VOL_FEATURES, &source);
     const int16 adds = sigma_t > 0.0f;
     if (VOL_ANY16(adds)) {
