@@ -350,42 +350,47 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   composite.setArg(4, low);
   composite.setArg(5, low_key);
   // Bands (rows: staged calls on devices of one pixel per work-item; else one band): whole
-  // work-groups of target rows, frame rows `scale` times as many. Composite band b reads target
-  // rows up to the first of band b + 1 (the upsampling's 2 x 2 taps): it waits for marches up to
-  // b + 1, and the queue runs march 0, march 1, composite 0, march 2, composite 1, ...
+  // work-groups of target rows, frame rows `scale` times as many. Composite band b reads the
+  // target rows of march band b, upsampled also the first of band b + 1 (the 2 x 2 taps), and goes
+  // right after the last march it reads, so that its download runs while later bands march. Two
+  // marches go first, so that the device marches while after_march sends the color up: at scale 1
+  // the queue runs march 0, march 1, composite 0, composite 1, march 2, composite 2, ...;
+  // upsampled march 0, march 1, composite 0, march 2, composite 1, ...
   const std::size_t low_height = std::size_t(f.low_height), scale = std::size_t(f.variant.scale);
   std::size_t band_rows = low_height;
   if (rows != nullptr && march_lanes == 1 && global[1] == std::size_t(fb.height)) {
     const std::size_t group = std::max(march_entry.shape.y, composite_entry.shape.y);
     band_rows = std::max(group, ((low_height + kRowBands - 1) / kRowBands + group - 1) / group * group);
   }
-  const std::size_t bands = (low_height + band_rows - 1) / band_rows;
+  const std::size_t bands = (low_height + band_rows - 1) / band_rows, look_ahead = scale > 1 ? 1 : 0;
   std::vector<cl::Event> marched(bands);
-  const auto march_band = [&](std::size_t b) {
-    const std::size_t first = b * band_rows;
+  std::size_t marches = 0;
+  const auto march_band = [&] {
+    const std::size_t first = marches * band_rows;
     queue.enqueueNDRangeKernel(march, cl::NDRange(0, first),
                                march_entry.shape.global(march_x, std::min(band_rows, low_height - first)),
-                               march_entry.shape.local(), b == 0 && !waits.empty() ? &waits : nullptr, &marched[b]);
+                               march_entry.shape.local(), marches == 0 && !waits.empty() ? &waits : nullptr,
+                               &marched[marches]);
+    ++marches;
     ++m.stats.march_dispatches;
   };
-  march_band(0);
-  if (bands > 1) march_band(1);
+  while (marches < std::min<std::size_t>(2, bands)) march_band();
   std::vector<cl::Event> uploaded;
   if (after_march) {
     queue.flush();  // the march may start while after_march works
     uploaded.push_back(after_march());
   }
   for (std::size_t b = 0; b < bands; ++b) {
+    while (marches < std::min(b + 1 + look_ahead, bands)) march_band();
     const std::size_t first = b * band_rows * scale;
     const std::size_t end = b + 1 == bands ? std::size_t(fb.height) : (b + 1) * band_rows * scale;
     std::vector<cl::Event> after = uploaded;
-    after.insert(after.end(), marched.begin(), marched.begin() + std::min(b + 2, bands));
+    after.insert(after.end(), marched.begin(), marched.begin() + marches);
     queue.enqueueNDRangeKernel(composite, cl::NDRange(0, first),
                                composite_entry.shape.global(global[0], b + 1 == bands ? global[1] - first : end - first),
                                composite_entry.shape.local(), &after, &done);
     ++m.stats.composite_dispatches;
     if (rows != nullptr) rows->push_back({int(end), done});
-    if (b + 2 < bands) march_band(b + 2);
     if (bands > 1) queue.flush();  // the band's download waits for it on another queue
   }
   if (scratch_set != nullptr) scratch_set->done = done;
