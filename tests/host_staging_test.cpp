@@ -10,6 +10,7 @@
 
 #include "fogcl/fog_pass.h"
 #include "fogcl/volume_pass.h"
+#include "runtime/host_staging.h"
 #include "runtime/pinned_memory.h"
 #include "test_support.h"
 #include "volume_support.h"
@@ -217,6 +218,34 @@ TEST(HostStaging, VolumesSameBytesAsDirect) {
     staged.apply(color, depth, c, t.frame.params, t.scene, settings);
     EXPECT_EQ(differing_bytes(a, c), 0u) << to_string(format) << " from pinned images";
   }
+}
+
+// What a band of rows waits for: every transfer up to the first that completes its rows (an
+// upload's bands may complete out of order), all of them past the last.
+TEST(HostStaging, RowsEventsCoverEveryBandUpToTheRows) {
+  FOGCL_REQUIRE_DEVICE();
+  const cl::Context context = wrap(runtime()->context());
+  using detail::HostStaging;
+  std::vector<HostStaging::RowsReady> ready;
+  for (int rows_end : {3, 3, 7, 10}) ready.push_back({rows_end, cl::UserEvent(context)});
+  const auto events = [&](int rows) {
+    std::vector<cl_event> handles;
+    for (const cl::Event& e : HostStaging::rows_events(ready, rows)) handles.push_back(e());
+    return handles;
+  };
+  const auto first = [&](std::size_t n) {
+    std::vector<cl_event> handles;
+    for (std::size_t i = 0; i < n; ++i) handles.push_back(ready[i].event());
+    return handles;
+  };
+  EXPECT_EQ(events(1), first(1));
+  EXPECT_EQ(events(3), first(1));
+  EXPECT_EQ(events(4), first(3));  // row 3 ends in the third band: the second holds part of it
+  EXPECT_EQ(events(7), first(3));
+  EXPECT_EQ(events(8), first(4));
+  EXPECT_EQ(events(10), first(4));
+  EXPECT_EQ(events(11), first(4));
+  for (HostStaging::RowsReady& r : ready) clSetUserEventStatus(r.event(), CL_COMPLETE);
 }
 
 // Staged calls on devices of one pixel per work-item march and composite in bands of rows, each

@@ -283,7 +283,8 @@ PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage&
                                          const Variant& v, const CameraParams& camera, const FogSettings& settings,
                                          cl::Event& done) {
   detail::HostStaging& staging = transfers.staging_of(context, device);
-  detail::StagedFrame frame = staging.start(in, depth, out, [&](const FrameBuffers& fb, const std::vector<cl::Event>&,
+  detail::StagedFrame frame = staging.start(in, depth, out, [&](const FrameBuffers& fb,
+                                                                const detail::HostStaging::UploadDepth&,
                                                                 const detail::HostStaging::UploadColor& upload_color) {
     done = adopt(dispatch(queue, fb, v, camera, settings, {upload_color()()}));
     queue.flush();

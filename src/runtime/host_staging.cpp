@@ -308,18 +308,17 @@ StagingSlot& HostStaging::take_slot(int width, int height, ColorFormat format) {
   return *slots_.back();
 }
 
-// One image's bytes to a device buffer of the slot: where the image is pinned memory of this
-// context, straight from it (then `direct` is set); else band by band through the slot's pinned
-// memory at `pinned`, each band's DMA enqueued by the thread that copies its last chunk. The
-// transfers' events are appended to `events` (may be null).
-void HostStaging::upload_image(const std::byte* src, std::size_t bytes, const cl::Buffer& to, std::byte* pinned,
-                               bool& direct, std::vector<cl::Event>* events) {
+// One image's bytes (`rows` rows) to a device buffer of the slot: where the image is pinned
+// memory of this context, straight from it (then `direct` is set); else band by band through the
+// slot's pinned memory at `pinned`, each band's DMA enqueued by the thread that copies its last
+// chunk. Returns the rows each transfer completes.
+std::vector<HostStaging::RowsReady> HostStaging::upload_image(const std::byte* src, std::size_t bytes, int rows,
+                                                              const cl::Buffer& to, std::byte* pinned, bool& direct) {
   direct = is_pinned(src, bytes, context_());
   if (direct) {
     cl::Event e;
     upload_queue_.enqueueWriteBuffer(to, CL_FALSE, 0, bytes, src, nullptr, &e);
-    if (events) events->push_back(e);
-    return;
+    return {{rows, e}};
   }
   const std::vector<Band> image_bands = bands(bytes);
   const std::vector<Chunk> image_chunks = chunks(image_bands);
@@ -335,7 +334,23 @@ void HostStaging::upload_image(const std::byte* src, std::size_t bytes, const cl
     const Band b = image_bands[c.band];
     upload_queue_.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done[c.band]);
   });
-  if (events) events->insert(events->end(), done.begin(), done.end());
+  // A band's DMA completes the rows that end within it, once those of the bands before it are
+  // done too (the threads may enqueue bands out of order).
+  const std::size_t row_bytes = bytes / std::size_t(rows);
+  std::vector<RowsReady> ready;
+  for (std::size_t b = 0; b < image_bands.size(); ++b)
+    ready.push_back({b + 1 == image_bands.size() ? rows : int((image_bands[b].offset + image_bands[b].bytes) / row_bytes),
+                     done[b]});
+  return ready;
+}
+
+std::vector<cl::Event> HostStaging::rows_events(const std::vector<RowsReady>& ready, int rows) {
+  std::vector<cl::Event> events;
+  for (const RowsReady& r : ready) {
+    events.push_back(r.event);
+    if (r.rows_end >= rows) break;
+  }
+  return events;
 }
 
 StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes) {
@@ -346,20 +361,28 @@ StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, Co
   // A throw before the download is queued drops `frame`, which waits for what was enqueued.
   // The depth goes first, so that what reads only the depth (the volumes' march) runs while the
   // color is copied and crosses the bus.
-  bool depth_direct = false, color_direct = false, color_sent = false;
-  upload_image(reinterpret_cast<const std::byte*>(depth.data()), s.depth_bytes(), s.depth, s.in + s.color_bytes(),
-               depth_direct, &s.depth_ready);
-  upload_queue_.flush();
+  bool depth_direct = false, color_direct = false, depth_sent = false, color_sent = false;
+  std::vector<RowsReady> depth_rows;
+  const UploadDepth upload_depth = [&] {
+    if (depth_sent) throw Error("HostStaging: the depth was uploaded twice");
+    depth_sent = true;
+    depth_rows = upload_image(reinterpret_cast<const std::byte*>(depth.data()), s.depth_bytes(), s.height, s.depth,
+                              s.in + s.color_bytes(), depth_direct);
+    for (const RowsReady& r : depth_rows) s.depth_ready.push_back(r.event);
+    upload_queue_.flush();
+    return depth_rows;
+  };
   const UploadColor upload_color = [&] {
     if (color_sent) throw Error("HostStaging: the color was uploaded twice");
     color_sent = true;
-    upload_image(static_cast<const std::byte*>(in.data()), s.color_bytes(), s.color_in, s.in, color_direct, nullptr);
+    if (!depth_sent) upload_depth();
+    upload_image(static_cast<const std::byte*>(in.data()), s.color_bytes(), s.height, s.color_in, s.in, color_direct);
     upload_queue_.enqueueMarkerWithWaitList(nullptr, &s.uploaded);
     upload_queue_.flush();
     return s.uploaded;
   };
-  const std::vector<RowsReady> ready = passes(s.raw, s.depth_ready, upload_color);
-  if (!color_sent) upload_color();  // every frame sends its color: `uploaded` ends the upload
+  const std::vector<RowsReady> ready = passes(s.raw, upload_depth, upload_color);
+  if (!color_sent) upload_color();  // every frame sends both images: `uploaded` ends the upload
   // The caller may change its images once this returns: the DMA from them must be over.
   if (color_direct || depth_direct) s.uploaded.wait();
   download(frame, ready, out);

@@ -100,31 +100,39 @@ class HostStaging {
 
   // A convenience call's round trip up to the result's download, with no host wait: in and depth
   // (same size) go up through a free slot's pinned memory, the depth first.
-  // passes(buffers, depth_ready, upload_color) enqueues the passes on the slot's device buffers:
-  // what reads only the depth after depth_ready, then calls upload_color(), which sends the color
-  // up and returns the event after which color and depth are on the device, and enqueues the rest
-  // after it; it returns when which rows of buffers.color_out are final (RowsReady, one entry
-  // for the whole frame or one per band of rows), which the download into `out` follows band by
-  // band. Returns once the host images may be reused (the DMA from the slot may still run); an
-  // image in pinned memory of this context (pinned_memory.h) crosses the bus from where it is,
-  // uncopied (then this waits for that DMA).
-  using UploadColor = std::function<cl::Event()>;
-  // Rows [the previous entry's rows_end, rows_end) of the output are final once `event` is
-  // complete; entries in ascending order, the last one ending at the frame's height.
+  // passes(buffers, upload_depth, upload_color) enqueues the passes on the slot's device buffers:
+  // it does what needs neither image, calls upload_depth(), which sends the depth up and returns
+  // when which rows of it are on the device, enqueues what reads only the depth after those rows,
+  // then calls upload_color(), which sends the color up (the depth first, if not sent) and
+  // returns the event after which color and depth are on the device, and enqueues the rest after
+  // it; it returns when which rows of buffers.color_out are final (one entry for the whole frame
+  // or one per band of rows), which the download into `out` follows band by band. An image that
+  // passes does not send goes up after it returns. Returns once the host images may be reused
+  // (the DMA from the slot may still run); an image in pinned memory of this context
+  // (pinned_memory.h) crosses the bus from where it is, uncopied (then this waits for that DMA).
+  //
+  // Rows [the previous entry's rows_end, rows_end) are there (uploaded, or final in the output)
+  // once `event` is complete; entries in ascending order, the last one ending at the frame's
+  // height. (An upload's bands may complete out of order: rows_events gives all a range needs.)
   struct RowsReady {
     int rows_end;
     cl::Event event;
   };
-  using Passes = std::function<std::vector<RowsReady>(
-      const FrameBuffers& buffers, const std::vector<cl::Event>& depth_ready, const UploadColor& upload_color)>;
+  using UploadDepth = std::function<std::vector<RowsReady>()>;
+  using UploadColor = std::function<cl::Event()>;
+  using Passes = std::function<std::vector<RowsReady>(const FrameBuffers& buffers, const UploadDepth& upload_depth,
+                                                      const UploadColor& upload_color)>;
+  // The events after which rows [0, rows) of `ready` are there: its entries up to the first that
+  // reaches `rows` (all of them past the last).
+  static std::vector<cl::Event> rows_events(const std::vector<RowsReady>& ready, int rows);
   StagedFrame start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes);
   // Waits for the download and copies it into `out` (the image given to start()); then the slot
   // is free for the next frame. Thread-safe against start() of other frames.
   void finish(StagedFrame& frame, ColorImage& out);
 
  private:
-  void upload_image(const std::byte* src, std::size_t bytes, const cl::Buffer& to, std::byte* pinned, bool& direct,
-                    std::vector<cl::Event>* events);
+  std::vector<RowsReady> upload_image(const std::byte* src, std::size_t bytes, int rows, const cl::Buffer& to,
+                                      std::byte* pinned, bool& direct);
   void download(StagedFrame& frame, const std::vector<RowsReady>& ready, ColorImage& out);
   friend class StagedFrame;
   void give_back(StagingSlot* slot);

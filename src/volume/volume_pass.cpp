@@ -100,17 +100,20 @@ struct VolumePass::Impl {
   }
   const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
                                     std::vector<cl::Event>& waits);
-  // VolumePass::enqueue's work after `waits`. after_march (may be empty) runs once the march is
-  // enqueued and flushed (the march reads the depth, not the color) and returns the event the
-  // composite waits for besides the march: the staged call sends the color up there. rows (the
+  // VolumePass::enqueue's work after `waits`. The staged call passes upload_depth, which sends
+  // the depth up once the frame's constants and kernels are ready and returns when which rows of
+  // it are there (each band of the march waits for its own), and after_march, which runs once
+  // the first marches are enqueued and flushed (the march reads the depth, not the color) and
+  // returns the event the composite waits for besides the march: the color sent up. rows (the
   // staged call; `queue` in order): on devices of one pixel per work-item the march and the
   // composite go in bands of rows, interleaved, and rows gets when each band of the output is
   // final, so that its download follows while the march goes on; else one entry.
+  using RowsReady = detail::HostStaging::RowsReady;
   using AfterMarch = detail::HostStaging::UploadColor;
   cl::Event enqueue_frame(const cl::CommandQueue& queue, const FrameBuffers& fb, const CameraParams& camera,
                           const VolumeScene& scene, const VolumeSettings& requested, const ShadowMapBuffer* shadow,
-                          std::vector<cl::Event> waits, const AfterMarch& after_march, float max_eye,
-                          std::vector<detail::HostStaging::RowsReady>* rows = nullptr);
+                          std::vector<cl::Event> waits, const detail::HostStaging::UploadDepth& upload_depth,
+                          const AfterMarch& after_march, float max_eye, std::vector<RowsReady>* rows = nullptr);
   // `settings` with its noise sampling resolved for this device: what the variant, its build
   // options and the noise upload are chosen from.
   VolumeSettings resolved(const VolumeSettings& settings) const {
@@ -224,7 +227,7 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
         detail::checked_queue(queue_handle, impl_->context, impl_->device, "VolumePass::enqueue");
     std::vector<cl::Event> waits;
     for (cl_event e : wait_list) waits.push_back(wrap(e));
-    return share(impl_->enqueue_frame(queue, fb, camera, scene, requested, shadow, std::move(waits), {}, max_eye));
+    return share(impl_->enqueue_frame(queue, fb, camera, scene, requested, shadow, std::move(waits), {}, {}, max_eye));
   });
 }
 
@@ -264,8 +267,9 @@ VolumePass::Impl::Scratch* VolumePass::Impl::take_scratch(const cl::CommandQueue
 cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const FrameBuffers& fb,
                                           const CameraParams& camera, const VolumeScene& scene,
                                           const VolumeSettings& requested, const ShadowMapBuffer* shadow,
-                                          std::vector<cl::Event> waits, const AfterMarch& after_march,
-                                          float max_eye, std::vector<detail::HostStaging::RowsReady>* rows) {
+                                          std::vector<cl::Event> waits,
+                                          const detail::HostStaging::UploadDepth& upload_depth,
+                                          const AfterMarch& after_march, float max_eye, std::vector<RowsReady>* rows) {
   Impl& m = *this;
   const VolumeSettings settings = m.resolved(requested);
   const detail::PackedVolumeFrame f =
@@ -363,14 +367,21 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
     band_rows = std::max(group, ((low_height + kRowBands - 1) / kRowBands + group - 1) / group * group);
   }
   const std::size_t bands = (low_height + band_rows - 1) / band_rows, look_ahead = scale > 1 ? 1 : 0;
+  const auto frame_rows_end = [&](std::size_t b) {  // of band b: target rows times scale
+    return b + 1 == bands ? fb.height : int(std::min((b + 1) * band_rows * scale, std::size_t(fb.height)));
+  };
+  std::vector<RowsReady> depth_rows;
+  if (upload_depth) depth_rows = upload_depth();
   std::vector<cl::Event> marched(bands);
   std::size_t marches = 0;
   const auto march_band = [&] {
     const std::size_t first = marches * band_rows;
+    std::vector<cl::Event> after = marches == 0 ? waits : std::vector<cl::Event>();
+    if (!depth_rows.empty())
+      for (const cl::Event& e : detail::HostStaging::rows_events(depth_rows, frame_rows_end(marches))) after.push_back(e);
     queue.enqueueNDRangeKernel(march, cl::NDRange(0, first),
                                march_entry.shape.global(march_x, std::min(band_rows, low_height - first)),
-                               march_entry.shape.local(), marches == 0 && !waits.empty() ? &waits : nullptr,
-                               &marched[marches]);
+                               march_entry.shape.local(), after.empty() ? nullptr : &after, &marched[marches]);
     ++marches;
     ++m.stats.march_dispatches;
   };
@@ -383,14 +394,14 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   for (std::size_t b = 0; b < bands; ++b) {
     while (marches < std::min(b + 1 + look_ahead, bands)) march_band();
     const std::size_t first = b * band_rows * scale;
-    const std::size_t end = b + 1 == bands ? std::size_t(fb.height) : (b + 1) * band_rows * scale;
+    const int end = frame_rows_end(b);
     std::vector<cl::Event> after = uploaded;
     after.insert(after.end(), marched.begin(), marched.begin() + marches);
     queue.enqueueNDRangeKernel(composite, cl::NDRange(0, first),
                                composite_entry.shape.global(global[0], b + 1 == bands ? global[1] - first : end - first),
                                composite_entry.shape.local(), &after, &done);
     ++m.stats.composite_dispatches;
-    if (rows != nullptr) rows->push_back({int(end), done});
+    if (rows != nullptr) rows->push_back({end, done});
     if (bands > 1) queue.flush();  // the band's download waits for it on another queue
   }
   if (scratch_set != nullptr) scratch_set->done = done;
@@ -438,12 +449,12 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
     if (m.staged()) {  // pinned staging (runtime/host_staging.h): the GPU default
       detail::HostStaging& staging = m.transfers.staging_of(m.context, m.device);
       detail::StagedFrame staged =
-          staging.start(in, depth, out, [&](const FrameBuffers& fb, const std::vector<cl::Event>& depth_ready,
+          staging.start(in, depth, out, [&](const FrameBuffers& fb, const detail::HostStaging::UploadDepth& upload_depth,
                                             const detail::HostStaging::UploadColor& upload_color) {
             // The march reads the depth only: it runs while the color is sent up.
-            std::vector<detail::HostStaging::RowsReady> rows;
-            m.enqueue_frame(m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, depth_ready, upload_color,
-                            max_eye, &rows);
+            std::vector<Impl::RowsReady> rows;
+            m.enqueue_frame(m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, {}, upload_depth,
+                            upload_color, max_eye, &rows);
             m.queue.flush();
             return rows;
           });
