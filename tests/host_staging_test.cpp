@@ -2,8 +2,11 @@
 // whatever it is. They must give the bytes of the direct path (on a CPU device: the kernel on the
 // images' own memory), for odd sizes, both storages, in place, with frames in flight and waited
 // for on another thread, and for the volumetric pass.
+#include <atomic>
+#include <chrono>
 #include <cstring>
 #include <future>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -218,6 +221,45 @@ TEST(HostStaging, VolumesSameBytesAsDirect) {
     staged.apply(color, depth, c, t.frame.params, t.scene, settings);
     EXPECT_EQ(differing_bytes(a, c), 0u) << to_string(format) << " from pinned images";
   }
+}
+
+// A begun batch runs on the threads while the caller works; wait() joins in, runs every task
+// once and rethrows the first exception; a batch dropped unwaited waits for its tasks; one task
+// or no threads run inline.
+TEST(CopyWorkers, BegunBatchesRunWhileTheCallerWorks) {
+  detail::CopyWorkers workers(4);
+  std::vector<std::atomic<int>> runs(64);
+  std::atomic<bool> caller_went_on{false}, task_saw_it{false};
+  {
+    detail::CopyWorkers::Batch batch = workers.begin(int(runs.size()), [&](int i) {
+      ++runs[i];
+      if (i != 0) return;
+      // Task 0 waits for the caller's work after begin(): a begin() that ran the batch itself
+      // would leave it waiting out the deadline.
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while (!caller_went_on.load() && std::chrono::steady_clock::now() < deadline) std::this_thread::yield();
+      task_saw_it = caller_went_on.load();
+    });
+    caller_went_on = true;
+    batch.wait();
+  }
+  EXPECT_TRUE(task_saw_it.load()) << "begin() returned only after its tasks";
+  for (std::size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].load(), 1) << "task " << i;
+  {
+    detail::CopyWorkers::Batch batch = workers.begin(16, [](int i) {
+      if (i == 5) throw Error("task 5");
+    });
+    EXPECT_THROW(batch.wait(), Error);
+  }
+  std::atomic<int> dropped{0};
+  { detail::CopyWorkers::Batch batch = workers.begin(32, [&](int) { ++dropped; }); }
+  EXPECT_EQ(dropped.load(), 32) << "a dropped batch returned before its tasks ran";
+  int inline_runs = 0;
+  detail::CopyWorkers none(1);
+  detail::CopyWorkers::Batch a = none.begin(3, [&](int) { ++inline_runs; });
+  EXPECT_EQ(inline_runs, 3) << "without threads, begin runs the tasks";
+  workers.run(8, [&](int) { ++inline_runs; });  // the next batch after the others ended
+  EXPECT_EQ(inline_runs, 11);
 }
 
 // What a band of rows waits for: every transfer up to the first that completes its rows (an

@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstring>
 #include <map>
+#include <optional>
+#include <utility>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -60,24 +62,64 @@ void CopyWorkers::work() {
   }
 }
 
-void CopyWorkers::run(int n, const std::function<void(int)>& task) {
-  if (n <= 0) return;
+CopyWorkers::Batch CopyWorkers::begin(int n, std::function<void(int)> task) {
+  Batch batch;
+  if (n <= 0) return batch;
   if (workers_.empty() || n == 1) {
     for (int i = 0; i < n; ++i) task(i);
-    return;
+    return batch;
   }
-  std::lock_guard<std::mutex> batch(batch_);
-  std::unique_lock<std::mutex> lock(mutex_);
-  task_ = &task;
-  next_ = 0;
-  count_ = n;
-  error_ = nullptr;
+  batch.batch_ = std::unique_lock<std::mutex>(batch_);
+  batch.task_ = std::make_unique<std::function<void(int)>>(std::move(task));
+  batch.owner_ = this;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    task_ = batch.task_.get();
+    next_ = 0;
+    count_ = n;
+    error_ = nullptr;
+  }
   wake_.notify_all();
-  while (take_and_run(lock)) {
+  return batch;
+}
+
+CopyWorkers::Batch::Batch(Batch&& other) noexcept
+    : owner_(std::exchange(other.owner_, nullptr)), task_(std::move(other.task_)), batch_(std::move(other.batch_)) {}
+
+CopyWorkers::Batch& CopyWorkers::Batch::operator=(Batch&& other) noexcept {
+  if (this != &other) {
+    try {
+      wait();
+    } catch (...) {  // as the destructor
+    }
+    owner_ = std::exchange(other.owner_, nullptr);
+    task_ = std::move(other.task_);
+    batch_ = std::move(other.batch_);
   }
-  finished_.wait(lock, [&] { return running_ == 0 && next_ >= count_; });
-  task_ = nullptr;
-  if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+  return *this;
+}
+
+CopyWorkers::Batch::~Batch() {
+  try {
+    wait();
+  } catch (...) {  // the caller is unwinding from an error of its own, or never asked
+  }
+}
+
+void CopyWorkers::Batch::wait() {
+  if (owner_ == nullptr) return;
+  CopyWorkers& w = *std::exchange(owner_, nullptr);
+  std::exception_ptr error;
+  {
+    std::unique_lock<std::mutex> lock(w.mutex_);
+    while (w.take_and_run(lock)) {
+    }
+    w.finished_.wait(lock, [&] { return w.running_ == 0 && w.next_ >= w.count_; });
+    w.task_ = nullptr;
+    error = std::exchange(w.error_, nullptr);
+  }
+  batch_.unlock();
+  if (error) std::rethrow_exception(error);
 }
 
 // ---- slots -------------------------------------------------------------------------------------
@@ -308,41 +350,74 @@ StagingSlot& HostStaging::take_slot(int width, int height, ColorFormat format) {
   return *slots_.back();
 }
 
-// One image's bytes (`rows` rows) to a device buffer of the slot: where the image is pinned
-// memory of this context, straight from it (then `direct` is set); else band by band through the
-// slot's pinned memory at `pinned`, each band's DMA enqueued by the thread that copies its last
-// chunk. Returns the rows each transfer completes.
-std::vector<HostStaging::RowsReady> HostStaging::upload_image(const std::byte* src, std::size_t bytes, int rows,
-                                                              const cl::Buffer& to, std::byte* pinned, bool& direct) {
-  direct = is_pinned(src, bytes, context_());
-  if (direct) {
-    cl::Event e;
-    upload_queue_.enqueueWriteBuffer(to, CL_FALSE, 0, bytes, src, nullptr, &e);
-    return {{rows, e}};
+namespace {
+// One image's bytes (`rows` rows) on their way to a device buffer of a slot, from construction:
+// where the image is pinned memory of the context, straight from it (direct()); else band by
+// band through the slot's pinned memory at `pinned`, the copies on `workers` while the caller
+// goes on, each band's DMA enqueued by the thread that copies its last chunk. ready() waits for
+// the copies and returns the rows each transfer completes. Not ready()'d when destroyed (an
+// error upstream), it waits for its transfers, which read memory the caller may then reuse.
+class ImageUpload {
+ public:
+  ImageUpload(CopyWorkers& workers, const cl::CommandQueue& queue, const cl::Context& context, const std::byte* src,
+              std::size_t bytes, int rows, const cl::Buffer& to, std::byte* pinned)
+      : rows_(rows), bytes_(bytes), direct_(is_pinned(src, bytes, context())) {
+    if (direct_) {
+      done_.resize(1);
+      queue.enqueueWriteBuffer(to, CL_FALSE, 0, bytes, src, nullptr, &done_[0]);
+      return;
+    }
+    bands_ = bands(bytes);
+    done_.resize(bands_.size());
+    // Chunks not yet copied per band: the thread that copies a band's last one sends the band.
+    left_ = std::make_unique<std::atomic<std::size_t>[]>(bands_.size());
+    for (std::size_t b = 0; b < bands_.size(); ++b)
+      left_[b].store((bands_[b].bytes + kChunkBytes - 1) / kChunkBytes, std::memory_order_relaxed);
+    std::vector<Chunk> image_chunks = chunks(bands_);
+    const int n = int(image_chunks.size());
+    copies_ = workers.begin(n, [this, image_chunks = std::move(image_chunks), &queue, to, src, pinned](int i) {
+      const Chunk c = image_chunks[i];
+      band_copy(pinned + c.offset, src + c.offset, c.bytes);
+      if (left_[c.band].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+      const Band b = bands_[c.band];
+      queue.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done_[c.band]);
+    });
   }
-  const std::vector<Band> image_bands = bands(bytes);
-  const std::vector<Chunk> image_chunks = chunks(image_bands);
-  std::vector<cl::Event> done(image_bands.size());
-  // Chunks not yet copied per band: the thread that copies a band's last one sends the band.
-  std::vector<std::atomic<std::size_t>> left(image_bands.size());
-  for (std::size_t b = 0; b < image_bands.size(); ++b)
-    left[b].store((image_bands[b].bytes + kChunkBytes - 1) / kChunkBytes, std::memory_order_relaxed);
-  up_workers_.run(int(image_chunks.size()), [&](int i) {
-    const Chunk c = image_chunks[i];
-    band_copy(pinned + c.offset, src + c.offset, c.bytes);
-    if (left[c.band].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
-    const Band b = image_bands[c.band];
-    upload_queue_.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done[c.band]);
-  });
-  // A band's DMA completes the rows that end within it, once those of the bands before it are
-  // done too (the threads may enqueue bands out of order).
-  const std::size_t row_bytes = bytes / std::size_t(rows);
-  std::vector<RowsReady> ready;
-  for (std::size_t b = 0; b < image_bands.size(); ++b)
-    ready.push_back({b + 1 == image_bands.size() ? rows : int((image_bands[b].offset + image_bands[b].bytes) / row_bytes),
-                     done[b]});
-  return ready;
-}
+  ImageUpload(const ImageUpload&) = delete;
+  ImageUpload& operator=(const ImageUpload&) = delete;
+  ~ImageUpload() {
+    try {
+      copies_.wait();  // first: its tasks use the members
+    } catch (...) {  // an error upstream is on its way already
+    }
+    if (!readied_)
+      for (cl::Event& e : done_)
+        if (e() != nullptr) e.wait();
+  }
+  bool direct() const { return direct_; }
+  std::vector<HostStaging::RowsReady> ready() {
+    copies_.wait();
+    readied_ = true;
+    if (direct_) return {{rows_, done_[0]}};
+    // A band's DMA completes the rows that end within it, once those of the bands before it are
+    // done too (the threads may enqueue bands out of order).
+    const std::size_t row_bytes = bytes_ / std::size_t(rows_);
+    std::vector<HostStaging::RowsReady> out;
+    for (std::size_t b = 0; b < bands_.size(); ++b)
+      out.push_back({b + 1 == bands_.size() ? rows_ : int((bands_[b].offset + bands_[b].bytes) / row_bytes), done_[b]});
+    return out;
+  }
+
+ private:
+  int rows_;
+  std::size_t bytes_;
+  bool direct_, readied_ = false;
+  std::vector<Band> bands_;
+  std::vector<cl::Event> done_;
+  std::unique_ptr<std::atomic<std::size_t>[]> left_;
+  CopyWorkers::Batch copies_;
+};
+}  // namespace
 
 std::vector<cl::Event> HostStaging::rows_events(const std::vector<RowsReady>& ready, int rows) {
   std::vector<cl::Event> events;
@@ -361,30 +436,34 @@ StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, Co
   // A throw before the download is queued drops `frame`, which waits for what was enqueued.
   // The depth goes first, so that what reads only the depth (the volumes' march) runs while the
   // color is copied and crosses the bus.
-  bool depth_direct = false, color_direct = false, depth_sent = false, color_sent = false;
+  // The depth's copies start now, while passes prepares its work.
+  ImageUpload depth_up(up_workers_, upload_queue_, context_, reinterpret_cast<const std::byte*>(depth.data()),
+                       s.depth_bytes(), s.height, s.depth, s.in + s.color_bytes());
+  std::optional<ImageUpload> color_up;
+  bool depth_sent = false;
   std::vector<RowsReady> depth_rows;
   const UploadDepth upload_depth = [&] {
     if (depth_sent) throw Error("HostStaging: the depth was uploaded twice");
     depth_sent = true;
-    depth_rows = upload_image(reinterpret_cast<const std::byte*>(depth.data()), s.depth_bytes(), s.height, s.depth,
-                              s.in + s.color_bytes(), depth_direct);
+    depth_rows = depth_up.ready();
     for (const RowsReady& r : depth_rows) s.depth_ready.push_back(r.event);
     upload_queue_.flush();
     return depth_rows;
   };
   const UploadColor upload_color = [&] {
-    if (color_sent) throw Error("HostStaging: the color was uploaded twice");
-    color_sent = true;
+    if (color_up) throw Error("HostStaging: the color was uploaded twice");
     if (!depth_sent) upload_depth();
-    upload_image(static_cast<const std::byte*>(in.data()), s.color_bytes(), s.height, s.color_in, s.in, color_direct);
+    color_up.emplace(up_workers_, upload_queue_, context_, static_cast<const std::byte*>(in.data()), s.color_bytes(),
+                     s.height, s.color_in, s.in);
+    color_up->ready();
     upload_queue_.enqueueMarkerWithWaitList(nullptr, &s.uploaded);
     upload_queue_.flush();
     return s.uploaded;
   };
   const std::vector<RowsReady> ready = passes(s.raw, upload_depth, upload_color);
-  if (!color_sent) upload_color();  // every frame sends both images: `uploaded` ends the upload
+  if (!color_up) upload_color();  // every frame sends both images: `uploaded` ends the upload
   // The caller may change its images once this returns: the DMA from them must be over.
-  if (color_direct || depth_direct) s.uploaded.wait();
+  if (color_up->direct() || depth_up.direct()) s.uploaded.wait();
   download(frame, ready, out);
   return frame;
 }

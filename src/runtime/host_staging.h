@@ -29,6 +29,8 @@ namespace fogcl::detail {
 
 // A few persistent threads for the staging copies: run(n, task) calls task(0..n-1) on them and
 // on the calling thread, and returns when all have run (the first exception is rethrown).
+// begin(n, task) starts the same on the threads alone and returns at once, so that the caller
+// works meanwhile; the Batch's wait() then joins in and returns when all have run.
 class CopyWorkers {
  public:
   explicit CopyWorkers(int threads);
@@ -36,8 +38,26 @@ class CopyWorkers {
   CopyWorkers(const CopyWorkers&) = delete;
   CopyWorkers& operator=(const CopyWorkers&) = delete;
   int threads() const { return int(workers_.size()) + 1; }
-  // One batch at a time: a second caller waits for the first's batch to end.
-  void run(int n, const std::function<void(int)>& task);
+  // A begun batch. Destroying it waits for its tasks (dropping their exception), so that no
+  // task outlives what it uses.
+  class Batch {
+   public:
+    Batch() = default;
+    Batch(Batch&& other) noexcept;
+    Batch& operator=(Batch&& other) noexcept;  // waits for its own tasks first
+    ~Batch();
+    void wait();
+
+   private:
+    friend class CopyWorkers;
+    CopyWorkers* owner_ = nullptr;
+    std::unique_ptr<std::function<void(int)>> task_;
+    std::unique_lock<std::mutex> batch_;
+  };
+  // One batch at a time: a second caller waits for the first's batch to end. Without threads,
+  // or for one task, begin runs the tasks itself.
+  Batch begin(int n, std::function<void(int)> task);
+  void run(int n, const std::function<void(int)>& task) { begin(n, task).wait(); }
 
  private:
   std::mutex batch_;
@@ -131,8 +151,6 @@ class HostStaging {
   void finish(StagedFrame& frame, ColorImage& out);
 
  private:
-  std::vector<RowsReady> upload_image(const std::byte* src, std::size_t bytes, int rows, const cl::Buffer& to,
-                                      std::byte* pinned, bool& direct);
   void download(StagedFrame& frame, const std::vector<RowsReady>& ready, ColorImage& out);
   friend class StagedFrame;
   void give_back(StagingSlot* slot);
