@@ -119,10 +119,12 @@ class HostStaging {
   HostStaging& operator=(const HostStaging&) = delete;
 
   // A convenience call's round trip up to the result's download, with no host wait: in and depth
-  // (same size) go up through a free slot's pinned memory, the depth first.
+  // (same size) go up through a free slot's pinned memory, the depth first, its copies begun
+  // before passes is called.
   // passes(buffers, upload_depth, upload_color) enqueues the passes on the slot's device buffers:
-  // it does what needs neither image, calls upload_depth(), which sends the depth up and returns
-  // when which rows of it are on the device, enqueues what reads only the depth after those rows,
+  // it does what needs neither image meanwhile, calls upload_depth(), which waits for the depth's
+  // copies and returns when which rows of it are on the device, enqueues what reads only the
+  // depth after those rows,
   // then calls upload_color(), which sends the color up (the depth first, if not sent) and
   // returns the event after which color and depth are on the device, and enqueues the rest after
   // it; it returns when which rows of buffers.color_out are final (one entry for the whole frame

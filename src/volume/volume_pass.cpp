@@ -100,14 +100,15 @@ struct VolumePass::Impl {
   }
   const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
                                     std::vector<cl::Event>& waits);
-  // VolumePass::enqueue's work after `waits`. The staged call passes upload_depth, which sends
-  // the depth up once the frame's constants and kernels are ready and returns when which rows of
-  // it are there (each band of the march waits for its own), and after_march, which runs once
-  // the first marches are enqueued and flushed (the march reads the depth, not the color) and
-  // returns the event the composite waits for besides the march: the color sent up. rows (the
-  // staged call; `queue` in order): on devices of one pixel per work-item the march and the
-  // composite go in bands of rows, interleaved, and rows gets when each band of the output is
-  // final, so that its download follows while the march goes on; else one entry.
+  // VolumePass::enqueue's work after `waits`. The staged call passes upload_depth, called once
+  // the frame's constants and kernels are ready (the depth's copies run meanwhile), which returns
+  // when which rows of the depth are there (each band of the march waits for its own), and
+  // after_march, which runs once the first marches are enqueued and flushed (the march reads the
+  // depth, not the color) and returns the event the composite waits for besides the march: the
+  // color sent up. rows (the staged call; `queue` in order): on devices of one pixel per
+  // work-item the march and the composite go in bands of rows, interleaved, and rows gets when
+  // each band of the output is final, so that its download follows while the march goes on;
+  // else one entry.
   using RowsReady = detail::HostStaging::RowsReady;
   using AfterMarch = detail::HostStaging::UploadColor;
   cl::Event enqueue_frame(const cl::CommandQueue& queue, const FrameBuffers& fb, const CameraParams& camera,
