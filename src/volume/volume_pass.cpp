@@ -28,6 +28,17 @@ struct Source {
 };
 const Source kMarch{"volume_march.cl", volume_march_cl, "volume_march"};
 const Source kComposite{"volume_composite.cl", volume_composite_cl, "volume_composite"};
+// `b` holding at least `bytes`: allocated anew where missing or too small.
+void fit_buffer(const cl::Context& ctx, cl::Buffer& b, std::size_t bytes, cl_mem_flags flags) {
+  if (b() == nullptr || b.getInfo<CL_MEM_SIZE>() < bytes) b = cl::Buffer(ctx, flags, bytes);
+}
+// The march's low-resolution output for `f`: RGBA in `low`, its depth key in `low_key`.
+void fit_march_output(const cl::Context& ctx, const detail::PackedVolumeFrame& f, cl::Buffer& low,
+                      cl::Buffer& low_key) {
+  const std::size_t low_pixels = std::size_t(f.low_width) * std::size_t(f.low_height);
+  fit_buffer(ctx, low, low_pixels * 4 * sizeof(float), CL_MEM_READ_WRITE);
+  fit_buffer(ctx, low_key, low_pixels * sizeof(float), CL_MEM_READ_WRITE);
+}
 }  // namespace
 
 struct VolumePass::Impl {
@@ -245,14 +256,9 @@ VolumePass::Impl::Scratch* VolumePass::Impl::take_scratch(const cl::CommandQueue
     if (scratch.size() == kScratchSets) return nullptr;
     s = &scratch.emplace_back();
   }
-  const std::size_t low_pixels = std::size_t(f.low_width) * std::size_t(f.low_height);
-  const auto fit = [&](cl::Buffer& b, std::size_t need, cl_mem_flags flags) {
-    if (b() == nullptr || b.getInfo<CL_MEM_SIZE>() < need) b = cl::Buffer(context, flags, need);
-  };
-  fit(s->frame, f.frame.size() * sizeof(float), CL_MEM_READ_ONLY);
-  fit(s->volumes, f.volumes.size() * sizeof(float), CL_MEM_READ_ONLY);
-  fit(s->low, low_pixels * 4 * sizeof(float), CL_MEM_READ_WRITE);
-  fit(s->low_key, low_pixels * sizeof(float), CL_MEM_READ_WRITE);
+  fit_buffer(context, s->frame, f.frame.size() * sizeof(float), CL_MEM_READ_ONLY);
+  fit_buffer(context, s->volumes, f.volumes.size() * sizeof(float), CL_MEM_READ_ONLY);
+  fit_march_output(context, f, s->low, s->low_key);
   s->frame_host.assign(f.frame.begin(), f.frame.end());
   s->volumes_host.assign(f.volumes.begin(), f.volumes.end());
   cl::Event e;
@@ -324,9 +330,7 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
             // until the kernels that use them are done)
     frame = constant_buffer(m.context, f.frame.data(), f.frame.size());
     volumes = constant_buffer(m.context, f.volumes.data(), f.volumes.size());
-    const std::size_t low_pixels = std::size_t(f.low_width) * std::size_t(f.low_height);
-    low = cl::Buffer(m.context, CL_MEM_READ_WRITE, low_pixels * 4 * sizeof(float));
-    low_key = cl::Buffer(m.context, CL_MEM_READ_WRITE, low_pixels * sizeof(float));
+    fit_march_output(m.context, f, low, low_key);
   }
   const cl::Buffer depth = wrap(fb.depth);
   int arg = 0;
