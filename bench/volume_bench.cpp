@@ -17,13 +17,15 @@
 //        8..256; full/half/quarter; 1..16 volumes): work = sum over target pixels of steps x the
 //        volumes the pixel's ray enters before the scene, ns_per_work = device time / work (flat
 //        if the cost grows as the work does; bench/plot_volume.py draws it)
-//   BM_VolumeStepCost/integrator/ablation   what a step is made of: the OpenCL march on the
-//        cache-resident 320x180 frame (half resolution: 160x90 targets), adaptive steps off so the
-//        work is fixed, ns_per_work = march time / work (one thread's share: x threads for the
-//        time a core spends). Ablations take parts out of the scene: 0 all (noise, detail noise,
-//        fades), 1 no detail noise, 2 no noise, 3 no noise and no fades, 4 all with the physical
-//        model's Riemann sum (no expm1 or division per step; physical only), 5 all with noise
-//        exponents 1.5 (four pow per step; the demo's exponents are 1, which skips pow)
+//   BM_VolumeStepCost/integrator/ablation/frame   what a step is made of: the OpenCL march, adaptive
+//        steps off so the work is fixed, ns_per_work = march time / work (on a CPU one thread's
+//        share: x threads for the time a core spends). frame 0: the cache-resident 320x180 frame
+//        at half resolution (160x90 targets), the noise as a buffer; frame 1: 1080p at full
+//        resolution with the noise as an image (a GPU's default, enough work to fill one).
+//        Ablations take parts out of the scene: 0 all (noise, detail noise, fades), 1 no detail
+//        noise, 2 no noise, 3 no noise and no fades, 4 all with the physical model's Riemann sum
+//        (no expm1 or division per step; physical only), 5 all with noise exponents 1.5 (four pow
+//        per step; the demo's exponents are 1, which skips pow)
 //   BM_VolumeComposite/integrator/f16/bilinear/sparse   the upsample + composite of BM_VolumeDevice at
 //        1080p half resolution (noise buffer) in both storages (RGBA32F, RGBA16F) and both
 //        upsamplings (depth-aware, bilinear); sparse 1: the scene without the haze around the camera
@@ -439,7 +441,9 @@ void ScalingArgs(benchmark::internal::Benchmark* b) {
 void BM_VolumeStepCost(benchmark::State& state) {
   const auto integrator = VolumeIntegrator(state.range(0));
   const int ablation = int(state.range(1));
-  const DemoFrame& f = frame(320);
+  const bool full_hd = state.range(2) == 1;
+  if (full_hd && runtime().is_cpu()) return state.SkipWithError("frame 1 is for GPUs (PoCL's images take seconds)");
+  const DemoFrame& f = frame(full_hd ? 1920 : 320);
   VolumeScene s = scene(integrator);
   for (FogVolume& v : s.volumes) {
     if (ablation == 1) v.detail_strength = 0.0f;
@@ -447,7 +451,7 @@ void BM_VolumeStepCost(benchmark::State& state) {
     if (ablation == 3) v.fade_edge = v.fade_y = v.proximity_fade = 0.0f, v.max_y = 1e4f;
     if (ablation == 5) v.fog_exponent = v.detail_exponent = 1.5f;
   }
-  VolumeSettings st = settings(ablation == 4 ? VolumeIntegrator::riemann : integrator, 2, false);
+  VolumeSettings st = settings(ablation == 4 ? VolumeIntegrator::riemann : integrator, full_hd ? 1 : 2, full_hd);
   st.adaptive_steps = false;  // the work is steps per entered volume
   DeviceFrame d(f, s, st);
   double march_ms = 0;
@@ -539,9 +543,9 @@ BENCHMARK(BM_VolumeOpenMP)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeScaling)->Apply(ScalingArgs);
 BENCHMARK(BM_VolumeStepCost)
-    ->ArgNames({"integrator", "ablation"})
-    ->ArgsProduct({{0}, {0, 1, 2, 3, 5}})
-    ->ArgsProduct({{1}, {0, 1, 2, 3, 4, 5}})
+    ->ArgNames({"integrator", "ablation", "frame"})
+    ->ArgsProduct({{0}, {0, 1, 2, 3, 5}, {0, 1}})
+    ->ArgsProduct({{1}, {0, 1, 2, 3, 4, 5}, {0, 1}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.3);

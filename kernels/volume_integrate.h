@@ -274,9 +274,10 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
     if (mask != 0u) {
       const VOL_REAL length_ab = b - a;
       const int n = vol_piece_segments(length_ab, steps, covered);
+      VOL_REAL s1 = a; /* segment j starts where segment j - 1 ends (j = 0: vol_segment_start's a) */
       for (int j = 0; j < n; ++j) {
-        const VOL_REAL s0 = vol_segment_start(a, length_ab, (VOL_REAL)j, (VOL_REAL)n);
-        const VOL_REAL s1 = j + 1 == n ? b : vol_segment_start(a, length_ab, (VOL_REAL)(j + 1), (VOL_REAL)n);
+        const VOL_REAL s0 = s1;
+        s1 = j + 1 == n ? b : vol_segment_start(a, length_ab, (VOL_REAL)(j + 1), (VOL_REAL)n);
         const VOL_REAL seg = s1 - s0, t = s0 + jitter * seg;
         const VOL_V3 p = origin + dir * t;
         const VOL_REAL lit = (features & VOL_FEATURE_SHADOW)

@@ -290,14 +290,15 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   float16 phase[VOL_MAX_VOLUMES];
   vol_physical_phases(vload16(0, cos_theta), volumes, count, phase);
   float16 i_r = 0.0f, i_g = 0.0f, i_b = 0.0f, optical = 0.0f;
+  float16 s1 = 0.0f; /* each lane's last segment end: the next segment's start within a piece */
   for (;;) {
     const int16 alive = vload16(0, live);
     if (!VOL_ANY16(alive)) break;
     const float16 pa = alive ? vload16(0, a) : 0.0f, pb = alive ? vload16(0, b) : 0.0f;
     const float16 pn = alive ? vload16(0, n) : 1.0f, pj = vload16(0, j);
     const float16 length = pb - pa;
-    const float16 s0 = vol_segment_start(pa, length, pj, pn);
-    const float16 s1 = pj + 1.0f == pn ? pb : vol_segment_start(pa, length, pj + 1.0f, pn);
+    const float16 s0 = pj == 0.0f ? pa : s1;
+    s1 = pj + 1.0f == pn ? pb : vol_segment_start(pa, length, pj + 1.0f, pn);
     const float16 seg = s1 - s0, t = s0 + jitter16 * seg;
     const vol_float3x16 p = vol_make3_x16(origin.x + dir.x * t, origin.y + dir.y * t, origin.z + dir.z * t);
     float16 lit = 1.0f;

@@ -1,13 +1,18 @@
 // Unit tests of the OpenCL runtime layer: error names and messages, device choice, device
 // lookup, the program cache and the Runtime object.
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <optional>
 #include <memory>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -280,6 +285,43 @@ TEST(ProgramCacheTest, CachesByDeviceSourceNameAndOptions) {
   float out[4] = {};
   q.enqueueReadBuffer(buf, CL_TRUE, 0, sizeof out, out);
   for (int i = 0; i < 4; ++i) EXPECT_EQ(out[i], in[i] * 2.5f) << i;
+}
+
+// FOGCL_PROGRAM_BINARIES=DIR writes each program built (the driver's binary) and its options to
+// DIR; a program taken from the cache is not written again, and without the variable nothing is.
+TEST(ProgramCacheTest, WritesBinariesWhereAsked) {
+  FOGCL_REQUIRE_DEVICE();
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("fogcl-binaries-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const auto files = [&] {
+    std::vector<fs::path> out;
+    for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path());
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  const cl_device_id device = test::runtime()->device();
+  ProgramCache cache(test::runtime()->context());
+  cache.get(device, "unwritten.cl", kGoodSource, "-cl-std=CL1.2");
+  setenv("FOGCL_PROGRAM_BINARIES", dir.c_str(), 1);
+  cache.get(device, "unwritten.cl", kGoodSource, "-cl-std=CL1.2");  // cached: not built again
+  EXPECT_TRUE(files().empty()) << "a cached program was written";
+  cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2 -D UNUSED=7");
+  unsetenv("FOGCL_PROGRAM_BINARIES");
+  cache.get(device, "good.cl", kGoodSource, "-cl-std=CL1.2 -D UNUSED=8");
+  const std::vector<fs::path> written = files();
+  ASSERT_EQ(written.size(), 2u) << "one .bin and one .options for the one program built with the variable set";
+  EXPECT_EQ(written[0].extension(), ".bin");
+  EXPECT_EQ(written[1].extension(), ".options");
+  EXPECT_EQ(written[0].stem(), written[1].stem());
+  EXPECT_EQ(written[0].filename().string().rfind("good.cl-", 0), 0u) << written[0];
+  EXPECT_GT(fs::file_size(written[0]), 0u);
+  std::ifstream options(written[1]);
+  std::string line;
+  std::getline(options, line);
+  EXPECT_EQ(line, "-cl-std=CL1.2 -D UNUSED=7");
+  fs::remove_all(dir);
 }
 
 TEST(ProgramCacheTest, InvalidOptionsThrowClError) {

@@ -1,3 +1,6 @@
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
 #include <future>
 #include <map>
 #include <mutex>
@@ -10,6 +13,32 @@ namespace fogcl {
 
 namespace {
 using Key = std::tuple<cl_device_id, std::string, std::string>;  // device, source name, options
+
+// FOGCL_PROGRAM_BINARIES=DIR: each program built is written to DIR as what the driver returns for
+// CL_PROGRAM_BINARIES (PTX on NVIDIA's OpenCL), with its source name and options beside it, to read
+// what a device's compiler made of a variant (docs/gpu.md). A failure to write is ignored: it is a
+// diagnostic, and the program is built either way.
+void write_binary(const cl::Program& program, const std::string& source_name, const std::string& options) {
+  const char* dir = std::getenv("FOGCL_PROGRAM_BINARIES");
+  if (dir == nullptr || *dir == '\0') return;
+  try {
+    const std::vector<std::vector<unsigned char>> binaries = program.getInfo<CL_PROGRAM_BINARIES>();
+    if (binaries.empty()) return;
+    char name[64];
+    std::snprintf(name, sizeof name, "%s-%016zx", source_name.c_str(),
+                  std::hash<std::string>{}(source_name + '\n' + options));
+    const std::string base = std::string(dir) + "/" + name;
+    if (std::FILE* f = std::fopen((base + ".bin").c_str(), "wb")) {
+      std::fwrite(binaries[0].data(), 1, binaries[0].size(), f);
+      std::fclose(f);
+    }
+    if (std::FILE* f = std::fopen((base + ".options").c_str(), "w")) {
+      std::fprintf(f, "%s\n", options.c_str());
+      std::fclose(f);
+    }
+  } catch (const cl::Error&) {
+  }
+}
 
 struct Entry {
   std::shared_future<cl::Program> program;  // ready once built; carries a build failure to waiters
@@ -58,6 +87,7 @@ cl_program ProgramCache::get(cl_device_id device, const std::string& source_name
     program = with_cl_errors([&] { return cl::Program(impl_->context, std::string(source)); });
     try {
       program.build(std::vector<cl::Device>{wrap(device)}, options.c_str());
+      write_binary(program, source_name, options);
     } catch (const cl::Error& e) {
       std::string log;
       try {
