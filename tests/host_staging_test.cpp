@@ -4,7 +4,9 @@
 // for on another thread, and for the volumetric pass.
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+#include <memory>
 #include <future>
 #include <thread>
 #include <vector>
@@ -288,6 +290,53 @@ TEST(HostStaging, RowsEventsCoverEveryBandUpToTheRows) {
   EXPECT_EQ(events(10), first(4));
   EXPECT_EQ(events(11), first(4));
   for (HostStaging::RowsReady& r : ready) clSetUserEventStatus(r.event(), CL_COMPLETE);
+}
+
+// upload_depth(rows) of a staged call: the entries it returns cover the rows asked for, a first
+// call for one row returns before the depth's last band (the march's first band goes while the
+// rest is copied), later calls cover more, the call for every row covers all, and what crossed the
+// bus is the depth and color given. 1024 x 1536: the depth is 6 MiB, several staging bands.
+TEST(HostStaging, DepthRowsComeInTheOrderAskedAndWhole) {
+  FOGCL_REQUIRE_DEVICE();
+  const cl::Context context = wrap(runtime()->context());
+  const cl::Device device = wrap(runtime()->device());
+  const int w = 1024, h = 1536;
+  ColorImage in(w, h, ColorFormat::rgba32f), out(w, h, ColorFormat::rgba32f);
+  DepthImage depth(w, h);
+  for (std::size_t i = 0; i < depth.pixel_count(); ++i) depth.data()[i] = float(i % 9973) / 9973.0f;
+  for (std::size_t i = 0; i < in.pixel_count() * 4; ++i) static_cast<float*>(in.data())[i] = float(i % 7919);
+  const std::shared_ptr<detail::HostStaging> staging = detail::HostStaging::shared(context, device);
+  const cl::CommandQueue queue(context, device);
+  std::vector<float> depth_back(depth.pixel_count());
+  std::vector<int> covered;
+  detail::StagedFrame frame = staging->start(
+      in, depth, out,
+      [&](const FrameBuffers& fb, const detail::HostStaging::UploadDepth& upload_depth,
+          const detail::HostStaging::UploadColor& upload_color) {
+        for (const int rows : {1, h / 2, h - 1, h}) {
+          const std::vector<detail::HostStaging::RowsReady> ready = upload_depth(rows);
+          EXPECT_FALSE(ready.empty());
+          if (ready.empty()) continue;
+          covered.push_back(ready.back().rows_end);
+          EXPECT_GE(ready.back().rows_end, rows) << "asked for " << rows << " rows";
+          for (std::size_t i = 1; i < ready.size(); ++i) EXPECT_GT(ready[i].rows_end, ready[i - 1].rows_end);
+        }
+        std::vector<cl::Event> all = detail::HostStaging::rows_events(upload_depth(h), h);
+        queue.enqueueReadBuffer(wrap(fb.depth), CL_TRUE, 0, depth.size_bytes(), depth_back.data(), &all);
+        const std::vector<cl::Event> color{upload_color()};
+        cl::Event copied;
+        queue.enqueueCopyBuffer(wrap(fb.color_in), wrap(fb.color_out), 0, 0, in.size_bytes(), &color, &copied);
+        queue.flush();
+        return std::vector<detail::HostStaging::RowsReady>{{h, copied}};
+      });
+  staging->finish(frame, out);
+  ASSERT_EQ(covered.size(), 4u);
+  EXPECT_LT(covered[0], h) << "the first band's rows waited for the whole depth";
+  EXPECT_EQ(covered[3], h);
+  std::printf("[ rows     ] asked 1, %d, %d, %d: covered %d, %d, %d, %d\n", h / 2, h - 1, h, covered[0], covered[1],
+              covered[2], covered[3]);
+  EXPECT_EQ(std::memcmp(depth_back.data(), depth.data(), depth.size_bytes()), 0) << "the depth that crossed the bus";
+  EXPECT_EQ(differing_bytes(in, out), 0u) << "the color that went up and down";
 }
 
 // Staged calls on devices of one pixel per work-item march and composite in bands of rows, each

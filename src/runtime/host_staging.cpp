@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <cstring>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <utility>
 
@@ -355,8 +357,9 @@ namespace {
 // where the image is pinned memory of the context, straight from it (direct()); else band by
 // band through the slot's pinned memory at `pinned`, the copies on `workers` while the caller
 // goes on, each band's DMA enqueued by the thread that copies its last chunk. ready() waits for
-// the copies and returns the rows each transfer completes. Not ready()'d when destroyed (an
-// error upstream), it waits for its transfers, which read memory the caller may then reuse.
+// the copies and returns the rows each transfer completes; ready_rows(rows) waits only for the
+// bands that hold rows [0, rows). Not ready()'d when destroyed (an error upstream), it waits for
+// its transfers, which read memory the caller may then reuse.
 class ImageUpload {
  public:
   ImageUpload(CopyWorkers& workers, const cl::CommandQueue& queue, const cl::Context& context, const std::byte* src,
@@ -373,6 +376,7 @@ class ImageUpload {
     left_ = std::make_unique<std::atomic<std::size_t>[]>(bands_.size());
     for (std::size_t b = 0; b < bands_.size(); ++b)
       left_[b].store((bands_[b].bytes + kChunkBytes - 1) / kChunkBytes, std::memory_order_relaxed);
+    sent_.assign(bands_.size(), false);
     std::vector<Chunk> image_chunks = chunks(bands_);
     const int n = int(image_chunks.size());
     copies_ = workers.begin(n, [this, image_chunks = std::move(image_chunks), &queue, to, src, pinned](int i) {
@@ -380,7 +384,15 @@ class ImageUpload {
       band_copy(pinned + c.offset, src + c.offset, c.bytes);
       if (left_[c.band].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
       const Band b = bands_[c.band];
-      queue.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done_[c.band]);
+      bool sent = false;
+      try {
+        queue.enqueueWriteBuffer(to, CL_FALSE, b.offset, b.bytes, pinned + b.offset, nullptr, &done_[c.band]);
+        sent = true;
+      } catch (...) {
+        mark(c.band, sent);  // a waiting ready_rows() learns of the failure from copies_
+        throw;
+      }
+      mark(c.band, sent);
     });
   }
   ImageUpload(const ImageUpload&) = delete;
@@ -398,23 +410,57 @@ class ImageUpload {
   std::vector<HostStaging::RowsReady> ready() {
     copies_.wait();
     readied_ = true;
+    return rows_ready(bands_.size());
+  }
+  // The entries of rows [0, rows), once the bands that hold them are sent: the copies of later
+  // bands go on. ready() still has to be called for the whole image.
+  std::vector<HostStaging::RowsReady> ready_rows(int rows) {
+    if (direct_ || rows >= rows_) return ready();
+    const std::size_t row_bytes = bytes_ / std::size_t(rows_);
+    std::size_t needed = 0;  // bands up to the one holding the last byte of row rows - 1
+    while (needed < bands_.size() && bands_[needed].offset < std::size_t(std::max(rows, 1)) * row_bytes) ++needed;
+    if (needed == bands_.size()) return ready();  // the whole image: its copies' batch ends here
+    std::unique_lock<std::mutex> lock(sent_mutex_);
+    sent_cv_.wait(lock, [&] { return failed_ || std::all_of(sent_.begin(), sent_.begin() + needed, [](bool b) { return b; }); });
+    if (failed_) {
+      lock.unlock();
+      ready();  // rethrows the copy thread's error
+    }
+    return rows_ready(needed);
+  }
+
+ private:
+  void mark(std::size_t band, bool sent) {
+    {
+      const std::lock_guard<std::mutex> lock(sent_mutex_);
+      if (sent)
+        sent_[band] = true;
+      else
+        failed_ = true;
+    }
+    sent_cv_.notify_all();
+  }
+  // The first n bands' entries. A band's DMA completes the rows that end within it, once those of
+  // the bands before it are done too (the threads may enqueue bands out of order).
+  std::vector<HostStaging::RowsReady> rows_ready(std::size_t n) const {
     if (direct_) return {{rows_, done_[0]}};
-    // A band's DMA completes the rows that end within it, once those of the bands before it are
-    // done too (the threads may enqueue bands out of order).
     const std::size_t row_bytes = bytes_ / std::size_t(rows_);
     std::vector<HostStaging::RowsReady> out;
-    for (std::size_t b = 0; b < bands_.size(); ++b)
+    for (std::size_t b = 0; b < n; ++b)
       out.push_back({b + 1 == bands_.size() ? rows_ : int((bands_[b].offset + bands_[b].bytes) / row_bytes), done_[b]});
     return out;
   }
 
- private:
   int rows_;
   std::size_t bytes_;
   bool direct_, readied_ = false;
   std::vector<Band> bands_;
   std::vector<cl::Event> done_;
   std::unique_ptr<std::atomic<std::size_t>[]> left_;
+  std::mutex sent_mutex_;  // guards sent_ and failed_
+  std::condition_variable sent_cv_;
+  std::vector<bool> sent_;  // per band: its DMA is enqueued (done_ holds its event)
+  bool failed_ = false;     // a band's enqueue threw
   CopyWorkers::Batch copies_;
 };
 }  // namespace
@@ -440,19 +486,21 @@ StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, Co
   ImageUpload depth_up(up_workers_, upload_queue_, context_, reinterpret_cast<const std::byte*>(depth.data()),
                        s.depth_bytes(), s.height, s.depth, s.in + s.color_bytes());
   std::optional<ImageUpload> color_up;
-  bool depth_sent = false;
+  bool depth_sent = false;  // all of it
   std::vector<RowsReady> depth_rows;
-  const UploadDepth upload_depth = [&] {
-    if (depth_sent) throw Error("HostStaging: the depth was uploaded twice");
-    depth_sent = true;
-    depth_rows = depth_up.ready();
-    for (const RowsReady& r : depth_rows) s.depth_ready.push_back(r.event);
+  const UploadDepth upload_depth = [&](int rows) {
+    if (depth_sent) return depth_rows;
+    std::vector<RowsReady> ready = depth_up.ready_rows(rows);
     upload_queue_.flush();
+    if (ready.back().rows_end < s.height) return ready;
+    depth_sent = true;
+    depth_rows = std::move(ready);
+    for (const RowsReady& r : depth_rows) s.depth_ready.push_back(r.event);
     return depth_rows;
   };
   const UploadColor upload_color = [&] {
     if (color_up) throw Error("HostStaging: the color was uploaded twice");
-    if (!depth_sent) upload_depth();
+    if (!depth_sent) upload_depth(s.height);
     color_up.emplace(up_workers_, upload_queue_, context_, static_cast<const std::byte*>(in.data()), s.color_bytes(),
                      s.height, s.color_in, s.in);
     color_up->ready();

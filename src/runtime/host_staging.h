@@ -122,9 +122,10 @@ class HostStaging {
   // (same size) go up through a free slot's pinned memory, the depth first, its copies begun
   // before passes is called.
   // passes(buffers, upload_depth, upload_color) enqueues the passes on the slot's device buffers:
-  // it does what needs neither image meanwhile, calls upload_depth(), which waits for the depth's
-  // copies and returns when which rows of it are on the device, enqueues what reads only the
-  // depth after those rows,
+  // it does what needs neither image meanwhile, calls upload_depth(rows), which waits for the
+  // copies of the depth's rows [0, rows) (the rest go on) and returns when which rows of it are
+  // on the device (at least those; all of them once every row was asked for), enqueues what reads
+  // only the depth after those rows (asking for more rows as it goes),
   // then calls upload_color(), which sends the color up (the depth first, if not sent) and
   // returns the event after which color and depth are on the device, and enqueues the rest after
   // it; it returns when which rows of buffers.color_out are final (one entry for the whole frame
@@ -140,7 +141,7 @@ class HostStaging {
     int rows_end;
     cl::Event event;
   };
-  using UploadDepth = std::function<std::vector<RowsReady>()>;
+  using UploadDepth = std::function<std::vector<RowsReady>(int rows)>;
   using UploadColor = std::function<cl::Event()>;
   using Passes = std::function<std::vector<RowsReady>(const FrameBuffers& buffers, const UploadDepth& upload_depth,
                                                       const UploadColor& upload_color)>;

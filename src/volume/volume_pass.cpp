@@ -69,8 +69,10 @@ struct VolumePass::Impl {
     cl::Event done;                               // the last composite that read the set
   };
   static constexpr std::size_t kScratchSets = 4;
-  // Bands of rows of a staged call's march and composite on GPUs (enqueue_frame's rows).
-  static constexpr std::size_t kRowBands = 4;
+  // Bands of rows of a staged call's march and composite on GPUs (enqueue_frame's rows), in
+  // shares of the target's rows: the last band's download is all that follows the last march, so
+  // it is the smallest (H100, docs/gpu.md: 0.16 ms of bus after the last composite with quarters).
+  static constexpr std::size_t kBandShares[] = {6, 6, 5, 3};
   std::vector<Scratch> scratch;
   // A free set sized for `f`, its constants' writes enqueued on `queue` (their events appended to
   // `writes`), or nullptr when every set is in flight.
@@ -112,8 +114,9 @@ struct VolumePass::Impl {
   const cl::Memory& noise_on_device(const cl::CommandQueue& queue, const VolumeSettings& settings,
                                     std::vector<cl::Event>& waits);
   // VolumePass::enqueue's work after `waits`. The staged call passes upload_depth, called once
-  // the frame's constants and kernels are ready (the depth's copies run meanwhile), which returns
-  // when which rows of the depth are there (each band of the march waits for its own), and
+  // the frame's constants and kernels are ready (the depth's copies run meanwhile), per band of
+  // the march with the rows it reads, which returns when which rows of the depth are there (each
+  // band of the march waits for its own, the first one not for the copies of the others), and
   // after_march, which runs once the first marches are enqueued and flushed (the march reads the
   // depth, not the color) and returns the event the composite waits for besides the march: the
   // color sent up. rows (the staged call; `queue` in order): on devices of one pixel per
@@ -366,26 +369,33 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   // the queue runs march 0, march 1, composite 0, composite 1, march 2, composite 2, ...;
   // upsampled march 0, march 1, composite 0, march 2, composite 1, ...
   const std::size_t low_height = std::size_t(f.low_height), scale = std::size_t(f.variant.scale);
-  std::size_t band_rows = low_height;
+  std::vector<std::size_t> band_start{0};  // each band's first target row, then the end
   if (rows != nullptr && march_lanes == 1 && global[1] == std::size_t(fb.height)) {
     const std::size_t group = std::max(march_entry.shape.y, composite_entry.shape.y);
-    band_rows = std::max(group, ((low_height + kRowBands - 1) / kRowBands + group - 1) / group * group);
+    std::size_t shares = 0, total = 0;
+    for (const std::size_t share : kBandShares) total += share;
+    for (std::size_t b = 0; b + 1 < std::size(kBandShares); ++b) {
+      shares += kBandShares[b];
+      const std::size_t end = (low_height * shares / total + group - 1) / group * group;
+      if (end > band_start.back() && end < low_height) band_start.push_back(end);
+    }
   }
-  const std::size_t bands = (low_height + band_rows - 1) / band_rows, look_ahead = scale > 1 ? 1 : 0;
+  band_start.push_back(low_height);
+  const std::size_t bands = band_start.size() - 1, look_ahead = scale > 1 ? 1 : 0;
   const auto frame_rows_end = [&](std::size_t b) {  // of band b: target rows times scale
-    return b + 1 == bands ? fb.height : int(std::min((b + 1) * band_rows * scale, std::size_t(fb.height)));
+    return b + 1 == bands ? fb.height : int(std::min(band_start[b + 1] * scale, std::size_t(fb.height)));
   };
-  std::vector<RowsReady> depth_rows;
-  if (upload_depth) depth_rows = upload_depth();
   std::vector<cl::Event> marched(bands);
   std::size_t marches = 0;
   const auto march_band = [&] {
-    const std::size_t first = marches * band_rows;
+    const std::size_t first = band_start[marches];
     std::vector<cl::Event> after = marches == 0 ? waits : std::vector<cl::Event>();
-    if (!depth_rows.empty())
-      for (const cl::Event& e : detail::HostStaging::rows_events(depth_rows, frame_rows_end(marches))) after.push_back(e);
+    if (upload_depth) {  // the band's rows of the depth: the first band marches while the rest are copied
+      const int rows_end = frame_rows_end(marches);
+      for (const cl::Event& e : detail::HostStaging::rows_events(upload_depth(rows_end), rows_end)) after.push_back(e);
+    }
     queue.enqueueNDRangeKernel(march, cl::NDRange(0, first),
-                               march_entry.shape.global(march_x, std::min(band_rows, low_height - first)),
+                               march_entry.shape.global(march_x, band_start[marches + 1] - first),
                                march_entry.shape.local(), after.empty() ? nullptr : &after, &marched[marches]);
     ++marches;
     ++m.stats.march_dispatches;
@@ -398,7 +408,7 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   }
   for (std::size_t b = 0; b < bands; ++b) {
     while (marches < std::min(b + 1 + look_ahead, bands)) march_band();
-    const std::size_t first = b * band_rows * scale;
+    const std::size_t first = band_start[b] * scale;
     const int end = frame_rows_end(b);
     std::vector<cl::Event> after = uploaded;
     after.insert(after.end(), marched.begin(), marched.begin() + marches);
