@@ -5,8 +5,9 @@
 //        composite = the composite kernel), counters march_ms, composite_ms and
 //        steps_x_pixels_per_s = steps x target pixels / march time; max_err against the scalar
 //        double path at 480x270
-//   BM_VolumeHostCall/integrator/divisor/noise_image/width   the convenience call, host images in
-//        and out (enqueue to finish): on a GPU the host round trip, upload + pass + download
+//   BM_VolumeHostCall/integrator/divisor/noise_image/width/f16   the convenience call, host images
+//        in and out (enqueue to finish), RGBA32F or (f16 1) RGBA16F: on a GPU the host round trip,
+//        upload + pass + download; width 3840 (4K) on GPUs only
 //   BM_VolumeScalar/integrator/width   the scalar float path, one thread
 //   BM_VolumeNothingVisible   enqueue of a frame whose volumes are all culled: no kernel, the
 //        host-side cost of the call
@@ -356,13 +357,15 @@ void BM_VolumeCompositeKernel(benchmark::State& state) {
 void BM_VolumeHostCall(benchmark::State& state) {
   const auto integrator = VolumeIntegrator(state.range(0));
   const int divisor = int(state.range(1)), width = int(state.range(3));
+  if (width > 1920 && runtime().is_cpu()) return state.SkipWithError("4K round trips are for GPUs");
   const DemoFrame& f = frame(width);
+  const ColorImage in = convert(f.color, state.range(4) ? ColorFormat::rgba16f : ColorFormat::rgba32f);
   const VolumeScene s = scene(integrator);
   const VolumeSettings st = settings(integrator, divisor, state.range(2) != 0);
   VolumePass pass(runtime());
   ColorImage out;
-  pass.apply(f.color, f.depth, out, f.params, s, st);  // builds the variant, uploads the noise
-  for (auto _ : state) pass.apply(f.color, f.depth, out, f.params, s, st);
+  pass.apply(in, f.depth, out, f.params, s, st);  // builds the variant, uploads the noise
+  for (auto _ : state) pass.apply(in, f.depth, out, f.params, s, st);
 }
 
 void BM_VolumeScalar(benchmark::State& state) {
@@ -525,8 +528,8 @@ BENCHMARK(BM_VolumeCompositeKernel)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeHostCall)
-    ->ArgNames({"integrator", "divisor", "noise_image", "width"})
-    ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}, {1920}})
+    ->ArgNames({"integrator", "divisor", "noise_image", "width", "f16"})
+    ->ArgsProduct({{0, 1}, {1, 2}, {0, 1}, {1920, 3840}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeScalar)

@@ -156,7 +156,8 @@ if vol:
         if b["base"].startswith("BM_VolumeDevice/") and a["width"] == "480":
             errs[(a["integrator"], a["divisor"], a["noise_image"])] = b.get("max_err", float("nan"))
         if b["base"].startswith("BM_VolumeHostCall/"):
-            host[(a["integrator"], a["divisor"], a["noise_image"], a["width"])] = b
+            if a.get("f16", "0") == "0":
+                host[(a["integrator"], a["divisor"], a["noise_image"], a["width"])] = b
     for b in vol:
         if not b["base"].startswith("BM_VolumeDevice/"):
             continue
@@ -193,7 +194,7 @@ if scalar:
 # Each convenience call's round trip (BM_OpenCLHostCall in fog-gpu.json, BM_VolumeHostCall in
 # volume-gpu.json) against BM_PinnedTransfer of the same bytes from the deferred run (color and
 # depth up, color down: the three buffers both passes' apply moves), matched by frame size and
-# storage. BM_VolumeHostCall names its width only (height = width * 9 / 16) and runs RGBA32F.
+# storage. BM_VolumeHostCall names its width only (height = width * 9 / 16) and its storage (f16).
 # ratio = round trip ms / pinned transfer ms; above 1.5 a line starts with FAILED.
 transfers = {}
 for b in fog:
@@ -216,7 +217,7 @@ if transfers:
             res = {"1": "full", "2": "half", "4": "quarter"}.get(a["divisor"], a["divisor"])
             what = (f'volume {"physical" if a["integrator"] == "1" else "stylized"} {res}, '
                     f'noise {"image" if a["noise_image"] == "1" else "buffer"}')
-            trips.append((what, a["width"], str(int(a["width"]) * 9 // 16), "0", b))
+            trips.append((what, a["width"], str(int(a["width"]) * 9 // 16), a.get("f16", "0"), b))
     p("## Host round trip vs the pinned transfer of its bytes (median of 3)")
     p()
     p("Round trip: the convenience call, host images in and out. Pinned / pageable: BM_PinnedTransfer,")
