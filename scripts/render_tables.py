@@ -255,7 +255,7 @@ def deferred_h100(root):
 
 
 def volume_h100(root):
-    b = Bench(root, "gpu-h100-2026-11-26-row-order/volume-gpu.json")
+    b = Bench(root, "gpu-h100-2026-11-26-bands/volume-gpu.json")
     cases = [(2, 1, "half resolution, noise as an image (texture unit)", "≤ 1 ms"),
              (1, 1, "full resolution, noise as an image", "≤ 4 ms"),
              (2, 0, "half resolution, noise as a buffer (manual trilinear)", "≤ 1 ms"),
