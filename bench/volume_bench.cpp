@@ -55,6 +55,7 @@
 #include "fogcl/volume_pass.h"
 #include "fogcl/volume_scalar.h"
 #include "runtime/clhpp.h"
+#include "runtime/host_staging.h"
 #include "runtime/work_groups.h"
 #include "volume/volume_formulas.h"
 #include "volume/volume_params.h"
@@ -488,7 +489,8 @@ void BM_VolumeNothingVisible(benchmark::State& state) {
 
 // The host's culling input of every VolumePass::apply: the farthest eye depth of the 1080p frame.
 // sky:1 the demo frame (the first sky pixel ends the scan), sky:0 the same frame with its sky
-// replaced by the far ground (every pixel read).
+// replaced by the far ground (every pixel read); threads 8: the chunks on 8 copy threads, as a staged
+// (GPU) call scans them.
 void BM_MaxEyeDepth(benchmark::State& state) {
   const DemoFrame& f = frame(1920);
   DepthImage depth = f.depth;
@@ -498,14 +500,17 @@ void BM_MaxEyeDepth(benchmark::State& state) {
       if (depth.data()[i] < 0.999f) ground = std::max(ground, depth.data()[i]);
     for (std::size_t i = 0; i < depth.pixel_count(); ++i) depth.data()[i] = std::min(depth.data()[i], ground);
   }
+  // threads > 1: the scan's chunks on that many copy threads, as a staged call runs it.
+  std::unique_ptr<detail::CopyWorkers> workers;
+  if (state.range(1) > 1) workers = std::make_unique<detail::CopyWorkers>(int(state.range(1)));
   float farthest = 0.0f;
-  for (auto _ : state) benchmark::DoNotOptimize(farthest = max_eye_depth(depth, f.params));
+  for (auto _ : state) benchmark::DoNotOptimize(farthest = detail::max_eye_depth(depth, f.params, workers.get()));
   state.counters["farthest"] = farthest;
 }
 
 }  // namespace
 
-BENCHMARK(BM_MaxEyeDepth)->ArgNames({"sky"})->Args({0})->Args({1})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MaxEyeDepth)->ArgNames({"sky", "threads"})->ArgsProduct({{0, 1}, {1, 8}})->UseRealTime()->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_VolumeDevice)
     ->ArgNames({"integrator", "divisor", "noise_image", "width"})
     ->ArgsProduct({{0, 1}, {1, 2, 4}, {0, 1}, {480}})

@@ -5,7 +5,9 @@
 #include <limits>
 #include <vector>
 
+#include "runtime/host_staging.h"
 #include "volume/volume_formulas.h"
+#include "volume/volume_params.h"
 #include "volume_support.h"
 
 namespace fogcl::test {
@@ -187,6 +189,7 @@ TEST(VolumeCulling, MaxEyeDepthIsTheLargestPixelEyeDepth) {
   const float specials[] = {0.0f, -0.0f, 1.0f, -3.0f, 2.0f, 1000.0f, 0.99995f, INFINITY, -INFINITY,
                             std::numeric_limits<float>::quiet_NaN()};
   int cases = 0;
+  detail::CopyWorkers workers(4);
   for (int projection = 0; projection < 3; ++projection)
     for (int kind = 0; kind < 3; ++kind)
       for (bool reversed : {false, true}) {
@@ -200,9 +203,9 @@ TEST(VolumeCulling, MaxEyeDepthIsTheLargestPixelEyeDepth) {
         camera.depth_kind = DepthKind(kind);
         for (unsigned seed = 0; seed < 24; ++seed) {
           // Ordinary values of the kind's range, then up to two specials in some frames.
-          // The last frame spans two of max_eye_depth's 64K-pixel passes, a special in the second.
-          const bool large = seed == 23;
-          DepthImage depth(large ? 400 : 37, large ? 200 : 5);
+          // The last three frames span four of max_eye_depth's 64K-pixel chunks, a special in the last.
+          const bool large = seed >= 21;
+          DepthImage depth(large ? 500 : 37, large ? 400 : 5);
           unsigned x = seed * 2654435761u + 1u;
           const float scale = kind == 0 ? 1.0f : 900.0f;
           for (std::size_t i = 0; i < depth.pixel_count(); ++i) {
@@ -223,10 +226,15 @@ TEST(VolumeCulling, MaxEyeDepthIsTheLargestPixelEyeDepth) {
           EXPECT_EQ(std::memcmp(&got, &expected, sizeof got), 0)
               << "projection " << projection << " kind " << kind << " reversed " << reversed << " seed " << seed
               << ": " << got << " against " << expected;
+          // The chunks spread over threads (a staged call's scan): the same float.
+          const float spread = detail::max_eye_depth(depth, camera, &workers);
+          EXPECT_EQ(std::memcmp(&spread, &expected, sizeof spread), 0)
+              << "on 4 threads, projection " << projection << " kind " << kind << " reversed " << reversed << " seed "
+              << seed << ": " << spread << " against " << expected;
           ++cases;
         }
       }
-  std::printf("[ worst    ] max_eye_depth against the per-pixel maximum: %d frames, every one the same float\n", cases);
+  std::printf("[ worst    ] max_eye_depth against the per-pixel maximum: %d frames, on one thread and on 4, every one the same float\n", cases);
 }
 
 TEST(VolumeValidation, BadInputNamesTheValueAndTheRule) {

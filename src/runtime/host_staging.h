@@ -149,6 +149,9 @@ class HostStaging {
   // reaches `rows` (all of them past the last).
   static std::vector<cl::Event> rows_events(const std::vector<RowsReady>& ready, int rows);
   StagedFrame start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes);
+  // Threads for work on a frame's host images before start() (the upload's, idle until then; a
+  // batch of another frame's upload is waited for): the volume pass's culling scan of the depth.
+  CopyWorkers& scan_workers() { return up_workers_; }
   // Waits for the download and copies it into `out` (the image given to start()); then the slot
   // is free for the next frame. Thread-safe against start() of other frames.
   void finish(StagedFrame& frame, ColorImage& out);

@@ -432,7 +432,9 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
                        const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
   Impl& m = *impl_;
   validate_frame(in, depth);
-  const float max_eye = max_eye_depth(depth, camera);
+  // On a GPU the scan is on the critical path of the round trip: the staging's threads share it.
+  const float max_eye = detail::max_eye_depth(
+      depth, camera, m.staged() ? &m.transfers.staging_of(m.context, m.device).scan_workers() : nullptr);
   const bool in_place = &out == &in;
   if (!in_place && (out.width() != in.width() || out.height() != in.height() || out.format() != in.format()))
     out = ColorImage(in.width(), in.height(), in.format());
