@@ -510,7 +510,11 @@ void BM_MaxEyeDepth(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(BM_MaxEyeDepth)->ArgNames({"sky", "threads"})->ArgsProduct({{0, 1}, {1, 8}})->UseRealTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MaxEyeDepth)
+    ->ArgNames({"sky", "threads"})
+    ->ArgsProduct({{0, 1}, {1, 8}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_VolumeDevice)
     ->ArgNames({"integrator", "divisor", "noise_image", "width"})
     ->ArgsProduct({{0, 1}, {1, 2, 4}, {0, 1}, {480}})

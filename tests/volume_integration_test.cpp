@@ -234,7 +234,9 @@ TEST(VolumeCulling, MaxEyeDepthIsTheLargestPixelEyeDepth) {
           ++cases;
         }
       }
-  std::printf("[ worst    ] max_eye_depth against the per-pixel maximum: %d frames, on one thread and on 4, every one the same float\n", cases);
+  std::printf("[ worst    ] max_eye_depth against the per-pixel maximum: %d frames, on one thread and on 4, "
+              "every one the same float\n",
+              cases);
 }
 
 TEST(VolumeValidation, BadInputNamesTheValueAndTheRule) {

@@ -421,7 +421,9 @@ class ImageUpload {
     while (needed < bands_.size() && bands_[needed].offset < std::size_t(std::max(rows, 1)) * row_bytes) ++needed;
     if (needed == bands_.size()) return ready();  // the whole image: its copies' batch ends here
     std::unique_lock<std::mutex> lock(sent_mutex_);
-    sent_cv_.wait(lock, [&] { return failed_ || std::all_of(sent_.begin(), sent_.begin() + needed, [](bool b) { return b; }); });
+    sent_cv_.wait(lock, [&] {
+      return failed_ || std::all_of(sent_.begin(), sent_.begin() + std::ptrdiff_t(needed), [](bool b) { return b; });
+    });
     if (failed_) {
       lock.unlock();
       ready();  // rethrows the copy thread's error
