@@ -415,10 +415,9 @@ class ImageUpload {
   // The entries of rows [0, rows), once the bands that hold them are sent: the copies of later
   // bands go on. ready() still has to be called for the whole image.
   std::vector<HostStaging::RowsReady> ready_rows(int rows) {
-    if (direct_ || rows >= rows_) return ready();
-    const std::size_t row_bytes = bytes_ / std::size_t(rows_);
-    std::size_t needed = 0;  // bands up to the one holding the last byte of row rows - 1
-    while (needed < bands_.size() && bands_[needed].offset < std::size_t(std::max(rows, 1)) * row_bytes) ++needed;
+    if (direct_) return ready();
+    std::size_t needed = 1;  // bands up to the first that completes the rows
+    while (needed < bands_.size() && rows_end(needed - 1) < rows) ++needed;
     if (needed == bands_.size()) return ready();  // the whole image: its copies' batch ends here
     std::unique_lock<std::mutex> lock(sent_mutex_);
     sent_cv_.wait(lock, [&] {
@@ -442,14 +441,17 @@ class ImageUpload {
     }
     sent_cv_.notify_all();
   }
-  // The first n bands' entries. A band's DMA completes the rows that end within it, once those of
-  // the bands before it are done too (the threads may enqueue bands out of order).
+  // A band's DMA completes the rows that end within it, once those of the bands before it are
+  // done too (the threads may enqueue bands out of order).
+  int rows_end(std::size_t band) const {
+    const Band& b = bands_[band];
+    return band + 1 == bands_.size() ? rows_ : int((b.offset + b.bytes) / (bytes_ / std::size_t(rows_)));
+  }
+  // The first n bands' entries.
   std::vector<HostStaging::RowsReady> rows_ready(std::size_t n) const {
     if (direct_) return {{rows_, done_[0]}};
-    const std::size_t row_bytes = bytes_ / std::size_t(rows_);
     std::vector<HostStaging::RowsReady> out;
-    for (std::size_t b = 0; b < n; ++b)
-      out.push_back({b + 1 == bands_.size() ? rows_ : int((bands_[b].offset + bands_[b].bytes) / row_bytes), done_[b]});
+    for (std::size_t b = 0; b < n; ++b) out.push_back({rows_end(b), done_[b]});
     return out;
   }
 
@@ -488,21 +490,19 @@ StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, Co
   ImageUpload depth_up(up_workers_, upload_queue_, context_, reinterpret_cast<const std::byte*>(depth.data()),
                        s.depth_bytes(), s.height, s.depth, s.in + s.color_bytes());
   std::optional<ImageUpload> color_up;
-  bool depth_sent = false;  // all of it
-  std::vector<RowsReady> depth_rows;
+  std::vector<RowsReady> depth_rows;  // all of the depth's, once all of it is sent
   const UploadDepth upload_depth = [&](int rows) {
-    if (depth_sent) return depth_rows;
+    if (!depth_rows.empty()) return depth_rows;
     std::vector<RowsReady> ready = depth_up.ready_rows(rows);
     upload_queue_.flush();
     if (ready.back().rows_end < s.height) return ready;
-    depth_sent = true;
     depth_rows = std::move(ready);
     for (const RowsReady& r : depth_rows) s.depth_ready.push_back(r.event);
     return depth_rows;
   };
   const UploadColor upload_color = [&] {
     if (color_up) throw Error("HostStaging: the color was uploaded twice");
-    if (!depth_sent) upload_depth(s.height);
+    if (depth_rows.empty()) upload_depth(s.height);
     color_up.emplace(up_workers_, upload_queue_, context_, static_cast<const std::byte*>(in.data()), s.color_bytes(),
                      s.height, s.color_in, s.in);
     color_up->ready();

@@ -274,35 +274,30 @@ float max_eye_depth(const DepthImage& depth, const CameraParams& camera, CopyWor
   };
   constexpr std::size_t kChunk = std::size_t(1) << 16;
   const std::size_t n = depth.pixel_count(), chunks = (n + kChunk - 1) / kChunk;
-  float lo = kInf, hi = -kInf;
-  bool nan = false;
-  if (workers == nullptr || workers->threads() < 2 || chunks < 2) {
-    float farthest = 0.0f;
-    for (std::size_t at = 0; at < n; at += kChunk) {
-      value_range(depth.data() + at, std::min(kChunk, n - at), lo, hi, nan);
-      farthest = std::fmax(farthest, farthest_of(lo, hi, nan));
-      if (!(farthest < kInf)) return kInf;
-    }
-    return farthest;
-  }
   // The first chunk here: sky in the top rows (most outdoor frames) ends the scan without waking
   // the threads. Eye depth being monotonic, the farthest of the chunks' joint range is the frame's.
-  value_range(depth.data(), kChunk, lo, hi, nan);
-  if (!(farthest_of(lo, hi, nan) < kInf)) return kInf;
   struct Range {
     float lo = kInf, hi = -kInf;
     bool nan = false;
   };
   std::vector<Range> ranges(chunks);
   std::atomic<bool> sky{false};
-  workers->run(int(chunks - 1), [&](int c) {
+  const auto scan = [&](int c) {
     if (sky.load(std::memory_order_relaxed)) return;
-    Range& r = ranges[std::size_t(c) + 1];
-    const std::size_t at = (std::size_t(c) + 1) * kChunk;
+    Range& r = ranges[std::size_t(c)];
+    const std::size_t at = std::size_t(c) * kChunk;
     value_range(depth.data() + at, std::min(kChunk, n - at), r.lo, r.hi, r.nan);
     if (!(farthest_of(r.lo, r.hi, r.nan) < kInf)) sky.store(true, std::memory_order_relaxed);
-  });
+  };
+  scan(0);
   if (sky.load()) return kInf;
+  if (workers != nullptr)
+    workers->run(int(chunks - 1), [&](int c) { scan(c + 1); });
+  else
+    for (std::size_t c = 1; c < chunks; ++c) scan(int(c));
+  if (sky.load()) return kInf;
+  float lo = kInf, hi = -kInf;
+  bool nan = false;
   for (const Range& r : ranges) {
     lo = std::min(lo, r.lo);
     hi = std::max(hi, r.hi);

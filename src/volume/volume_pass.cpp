@@ -432,9 +432,10 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
                        const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
   Impl& m = *impl_;
   validate_frame(in, depth);
-  // On a GPU the scan is on the critical path of the round trip: the staging's threads share it.
-  const float max_eye = detail::max_eye_depth(
-      depth, camera, m.staged() ? &m.transfers.staging_of(m.context, m.device).scan_workers() : nullptr);
+  // Pinned staging (runtime/host_staging.h), the GPU default. There the culling scan is on the
+  // critical path of the round trip: the staging's threads share it.
+  detail::HostStaging* staging = m.staged() ? &m.transfers.staging_of(m.context, m.device) : nullptr;
+  const float max_eye = detail::max_eye_depth(depth, camera, staging ? &staging->scan_workers() : nullptr);
   const bool in_place = &out == &in;
   if (!in_place && (out.width() != in.width() || out.height() != in.height() || out.format() != in.format()))
     out = ColorImage(in.width(), in.height(), in.format());
@@ -463,11 +464,11 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
                                  const_cast<float*>(shadow->depth.data()));
       sm.depth = shadow_buffer();
     }
-    if (m.staged()) {  // pinned staging (runtime/host_staging.h): the GPU default
-      detail::HostStaging& staging = m.transfers.staging_of(m.context, m.device);
-      detail::StagedFrame staged =
-          staging.start(in, depth, out, [&](const FrameBuffers& fb, const detail::HostStaging::UploadDepth& upload_depth,
-                                            const detail::HostStaging::UploadColor& upload_color) {
+    if (staging != nullptr) {
+      detail::StagedFrame staged = staging->start(
+          in, depth, out,
+          [&](const FrameBuffers& fb, const detail::HostStaging::UploadDepth& upload_depth,
+              const detail::HostStaging::UploadColor& upload_color) {
             // The march reads the depth only: it runs while the color is sent up.
             std::vector<Impl::RowsReady> rows;
             m.enqueue_frame(m.queue, fb, camera, scene, settings, shadow ? &sm : nullptr, {}, upload_depth,
@@ -475,7 +476,7 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
             m.queue.flush();
             return rows;
           });
-      staging.finish(staged, out);
+      staging->finish(staged, out);
       return;
     }
     const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
