@@ -360,10 +360,10 @@ def volume_budget(root):
 def readme_speed(root):
     d2 = Bench(root, "local-2core-streaming/hostcall-halide-device-final.json")
     suite = Bench(root, "local-2core-streaming/fog.json")
-    gpu = Bench(root, "gpu-h100-2026-11-26-readme/fog-gpu.json")
+    gpu = Bench(root, "gpu-h100-2026-11-26-readme-b/fog-gpu.json")
     march = Bench(root, "volume-local-2core/lanes-one-run.json")
     comp = Bench(root, "volume-composite-own-2026-11-24/fresh.json")
-    vgpu = Bench(root, "gpu-h100-2026-11-26-readme/volume-gpu.json")
+    vgpu = Bench(root, "gpu-h100-2026-11-26-readme-b/volume-gpu.json")
     key = dict(w=1920, h=1080, mode=2, dist=0, f16=0)
     dev = d2.get("BM_OpenCLDevice", nt=2, **key)
     call = d2.get("BM_OpenCLHostCall", **key)
@@ -424,7 +424,7 @@ def readme_speed(root):
     ]
     # The 2-vCPU Xeon (480 MiB L3), default settings (PoCL's threads floating); its ceiling is the
     # fastest of four copies of the row's bytes (ceiling_ms).
-    xe = Bench(root, "xeon-2core-readme-2026-11-26d/fog.json")
+    xe = Bench(root, "xeon-2core-readme-2026-11-26e/fog.json")
     xdev = xe.get("BM_OpenCLDevice", nt=2, **key)
     xcall = xe.get("BM_OpenCLHostCall", **key)
     xhal = xe.get("BM_Halide", **key)
