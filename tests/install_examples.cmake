@@ -82,7 +82,9 @@ expect_silent("the installed headers (all of them, no OpenCL macro set)")
 run(${CMAKE_COMMAND} -S ${prefix}/share/doc/fogcl/examples -B ${WORK_DIR}/build -DCMAKE_PREFIX_PATH=${prefix}
     -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}"
     "-DCMAKE_EXE_LINKER_FLAGS=${LINKER_FLAGS}" -DFOGCL_EXAMPLES_IO=ON)
-if(out MATCHES "CMake (Warning|Deprecation)")
+# (Debian's Imath package says its Python module is missing on every find_package(Imath), as a
+# status line: a shared fogcl does not look for Imath.)
+if(out MATCHES "CMake (Warning|Deprecation)|Imath::PyImath|file does not exist")
   message(FATAL_ERROR "configuring the examples against the install warned:\n${out}")
 endif()
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build -j 2)
