@@ -196,7 +196,8 @@ def check_library_names(root, prefix):
     headers, symbols, libs = installed_api(prefix)
     code = "\n".join(headers.values())
     header_refs, names = library_names(text)
-    problems = [f"docs/library.md names fogcl/{h}, which is not installed" for h in sorted(header_refs - headers.keys())]
+    problems = [f"docs/library.md names fogcl/{h}, which is not installed"
+                for h in sorted(header_refs - headers.keys())]
     functions = 0
     for name in sorted(names):
         shown = "::".join(name)
