@@ -1,4 +1,4 @@
-// Depth kinds (src/io/depth_kinds.cpp): eye depth and radial distance to raw device depth, checked
+// Depth kinds (src/camera/depth_kinds.cpp): eye depth and radial distance to raw device depth, checked
 // by going back with the formulas of docs/DESIGN.md §2 in double and with the camera's geometry.
 #include <cmath>
 #include <limits>

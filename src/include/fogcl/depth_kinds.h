@@ -1,6 +1,7 @@
 // What renderers write as depth, turned into the raw device depth the fog pass reads
-// (docs/DESIGN.md §2). OpenEXR's Z is "distance from the viewer"; renderers write it as linear eye
-// depth (along the view axis) or as radial distance from the eye.
+// (docs/DESIGN.md §2); plain maths, in the core library. OpenEXR's Z is "distance from the
+// viewer"; renderers write it as linear eye depth (along the view axis) or as radial distance from
+// the eye.
 #pragma once
 
 #include <string>

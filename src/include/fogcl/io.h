@@ -1,0 +1,6 @@
+// Umbrella header of fogcl::io (pkg-config fogcl-io, find_package(fogcl COMPONENTS io)): OpenEXR
+// in and out, PNG previews, on top of the whole library (fogcl/fogcl.h).
+#pragma once
+
+#include "fogcl/exr_io.h"
+#include "fogcl/fogcl.h"
