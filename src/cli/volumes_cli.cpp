@@ -1,11 +1,17 @@
 #include "cli/volumes_cli.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cfloat>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -25,6 +31,7 @@
 #include "fogcl/exr_io.h"
 #include "fogcl/volume_report.h"
 #include "fogcl/volume_scalar.h"
+#include "io/atomic_file.h"
 #include "runtime/format.h"
 
 namespace fogcl::cli {
@@ -351,12 +358,49 @@ std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::st
 }
 
 std::vector<FogVolume> read_volumes_json(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open the volumes file (--volumes)");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw Error(path + ": read error (--volumes)");
-  return parse_volumes_json(text.str(), path);
+  // Opened without blocking (a FIFO would wait for a writer) and checked before a byte is read:
+  // /dev/zero or a huge file must not grow the text until memory runs out.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw Error(path + ": cannot open the volumes file (--volumes)");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw Error(path + ": read error (--volumes): " + std::strerror(errno));
+  if (!S_ISREG(st.st_mode))
+    throw Error(path + ": the volumes file (--volumes) is " + detail::non_regular_kind(path) + ", not a regular file");
+  const auto too_large = [&](const std::string& size) {
+    return Error(path + ": the volumes file (--volumes) is " + size + ", more than the " +
+                 memory_text(kMaxVolumesJsonBytes) + " a VOLUMES.json may be");
+  };
+  if (std::uint64_t(st.st_size) > kMaxVolumesJsonBytes) throw too_large(memory_text(std::uint64_t(st.st_size)));
+  std::string text(std::size_t(st.st_size), '\0');
+  std::size_t got = 0;
+  for (;;) {  // to the end, which may have moved since fstat: never past the limit
+    if (got == text.size()) {
+      if (text.size() >= kMaxVolumesJsonBytes) {
+        char probe;
+        const ssize_t more = ::read(fd, &probe, 1);
+        if (more > 0)
+          throw Error(path + ": the volumes file (--volumes) grew past the " + memory_text(kMaxVolumesJsonBytes) +
+                      " a VOLUMES.json may be while it was read");
+        if (more == 0) break;
+        if (errno == EINTR) continue;
+        throw Error(path + ": read error (--volumes): " + std::strerror(errno));
+      }
+      text.resize(std::min<std::size_t>(kMaxVolumesJsonBytes, text.size() + 4096));
+    }
+    const ssize_t n = ::read(fd, text.data() + got, text.size() - got);
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw Error(path + ": read error (--volumes): " + std::strerror(errno));
+    }
+    got += std::size_t(n);
+  }
+  text.resize(got);
+  return parse_volumes_json(text, path);
 }
 
 namespace {

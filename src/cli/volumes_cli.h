@@ -59,6 +59,10 @@ void note_given_volume_flags(const CLI::App& apply, VolumeCliOptions& o);
 // "medium": "homogeneous" (a plain medium: noise and fades off, albedo and ambient 0 unless given;
 // it refuses the noise and fade keys). The values are as given: VolumeStage maps them from --axes.
 std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name);
+// The largest VOLUMES.json read: a scene's volumes take a few hundred bytes each.
+inline constexpr std::uint64_t kMaxVolumesJsonBytes = std::uint64_t(64) << 20;
+// The file at `path`: a regular file of at most kMaxVolumesJsonBytes, checked before it is read
+// (anything else is refused in one line naming the file and what it is or its size).
 std::vector<FogVolume> read_volumes_json(const std::string& path);
 // The inverse: every key of each volume (albedo and ambient only when set), parse_volumes_json
 // gives the same floats back.
