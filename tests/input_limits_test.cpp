@@ -28,9 +28,9 @@
 
 #include "cli/frame_memory.h"
 #include "cli/sequence.h"
-#include "cli/volumes_cli.h"
 #include "exr_fixtures.h"
 #include "fogcl/exr_io.h"
+#include "fogcl/volumes_json.h"
 #include "runtime/clhpp.h"
 #include "test_support.h"
 
@@ -520,16 +520,16 @@ TEST_F(InputLimits, AVolumesFileThatIsNotARegularFileOrTooLargeIsRefusedBeforeIt
   r = run(path("big.json"));
   std::printf("[ 100 MiB  ] exit %d, peak %.0f MiB: %s", r.exit_code, r.peak_mib, r.output.c_str());
   expect_refused_before_allocation(r, "fogcl: error: " + path("big.json") +
-                                          ": the volumes file (--volumes) is 100.0 MiB, more than the 64.0 MiB a "
-                                          "VOLUMES.json may be");
-  fs::resize_file(path("big.json"), cli::kMaxVolumesJsonBytes + 1);
+                                          ": the volumes file (--volumes) is 104857600 bytes, more than the 67108864 "
+                                          "bytes (64 MiB) a VOLUMES.json may be");
+  fs::resize_file(path("big.json"), kMaxVolumesJsonBytes + 1);
   r = run(path("big.json"));
-  EXPECT_MSG_HAS(r.output, "is 64.0 MiB, more than the 64.0 MiB");
+  EXPECT_MSG_HAS(r.output, "is 67108865 bytes, more than the 67108864 bytes (64 MiB)");
   // The limit itself is read: the volume, then spaces up to 64 MiB.
   const std::string volume = R"({"volumes": [{"center": [0, 1, 0], "radius": 2}]})";
   std::ofstream(path("big.json"), std::ios::trunc)
-      << volume << std::string(std::size_t(cli::kMaxVolumesJsonBytes) - volume.size(), ' ');
-  ASSERT_EQ(fs::file_size(path("big.json")), cli::kMaxVolumesJsonBytes);
+      << volume << std::string(std::size_t(kMaxVolumesJsonBytes) - volume.size(), ' ');
+  ASSERT_EQ(fs::file_size(path("big.json")), kMaxVolumesJsonBytes);
   r = run(path("big.json"));
   std::printf("[ 64 MiB   ] exit %d, peak %.0f MiB: %s\n", r.exit_code, r.peak_mib, r.output.c_str());
   EXPECT_EQ(r.exit_code, 0) << r.output;

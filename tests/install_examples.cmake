@@ -32,6 +32,14 @@ if(kernels)
   message(FATAL_ERROR "kernels are embedded, yet the install has ${kernels}")
 endif()
 get_filename_component(fogcl_dir ${config} DIRECTORY)
+# nlohmann-json is fogcl::io's build dependency only: no installed file may ask consumers for it.
+file(GLOB_RECURSE package_files ${fogcl_dir}/*.cmake ${prefix}/include/*.h)
+foreach(f IN LISTS package_files)
+  file(READ ${f} text)
+  if(text MATCHES "nlohmann")
+    message(FATAL_ERROR "${f} names nlohmann-json, a private build dependency of fogcl::io")
+  endif()
+endforeach()
 
 run(${CMAKE_COMMAND} -S ${SOURCE_DIR}/examples -B ${WORK_DIR}/build -Dfogcl_DIR=${fogcl_dir}
     -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCMAKE_CXX_COMPILER=${CXX} "-DCMAKE_CXX_FLAGS=${CXX_FLAGS}"
