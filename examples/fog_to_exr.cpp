@@ -1,11 +1,13 @@
 // fogcl::io (pkg-config fogcl-io, find_package(fogcl COMPONENTS io)): a frame fogged on the
 // OpenCL device, written as an OpenEXR file with its depth and as a PNG preview, then read back.
+// A VOLUMES.json document is parsed by the same library (the CLI's --volumes).
 // Usage: fog_to_exr OUT_DIR. Exit status 0 when the file holds the fogged frame bit for bit.
 #include <fogcl/io.h>
 
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <vector>
 
 int main(int argc, char** argv) try {
   if (argc != 2) {
@@ -40,7 +42,10 @@ int main(int argc, char** argv) try {
   std::printf("fogcl %s: wrote %s/fogged.exr, depth.exr, fogged.png; read back %s; fog %s the frame\n",
               fogcl::library_version(), dir.c_str(), same ? "bit for bit" : "DIFFERENT",
               changed ? "changed" : "did NOT change");
-  return same && changed ? 0 : 1;
+  const std::vector<fogcl::FogVolume> volumes =
+      fogcl::parse_volumes_json(R"({"volumes": [{"center": [0, 1, 4], "radius": 2}]})", "inline.json");
+  std::printf("VOLUMES.json: %zu volume(s), radius %g\n", volumes.size(), double(volumes.at(0).radius));
+  return same && changed && volumes.size() == 1 && volumes[0].radius == 2.0f ? 0 : 1;
 } catch (const fogcl::Error& e) {
   std::fprintf(stderr, "fog_to_exr: %s\n", e.what());
   return 1;

@@ -9,17 +9,17 @@
 #include <string>
 #include <vector>
 
-#include "cli/volumes_cli.h"
 #include "exr_fixtures.h"
 #include "fogcl/demo_scene.h"
+#include "fogcl/volumes_json.h"
 
 namespace {
 
 void write_json_seeds(const std::string& dir) {
   std::filesystem::create_directories(dir);
   const auto put = [&](const std::string& name, const std::string& text) { std::ofstream(dir + "/" + name) << text; };
-  put("volumes.json", fogcl::cli::volumes_to_json(fogcl::demo_fog_volumes(fogcl::VolumeIntegrator::stylized)));
-  put("volumes-physical.json", fogcl::cli::volumes_to_json(fogcl::demo_fog_volumes(fogcl::VolumeIntegrator::physical)));
+  put("volumes.json", fogcl::volumes_to_json(fogcl::demo_fog_volumes(fogcl::VolumeIntegrator::stylized)));
+  put("volumes-physical.json", fogcl::volumes_to_json(fogcl::demo_fog_volumes(fogcl::VolumeIntegrator::physical)));
   put("minimal.json", R"({"volumes": [{"center": [0, 1, 0], "radius": 2}]})");
   put("homogeneous.json", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "medium": "homogeneous", "albedo": [0.5, 0.5, 0.5]}]})");
   put("empty.json", R"({"volumes": []})");

@@ -1,4 +1,4 @@
-// libFuzzer target over the VOLUMES.json parser (src/cli/volumes_cli.cpp, parse_volumes_json): the
+// libFuzzer target over the VOLUMES.json parser (src/io/volumes_json.cpp, fogcl::parse_volumes_json): the
 // text `fogcl apply --volumes` reads. The contract under test: any input either gives volumes that
 // pass fogcl::validate and survive a round trip through volumes_to_json unchanged, or throws
 // fogcl::Error with one line; no crash (nesting 100 000 deep included), no other exception, no
@@ -10,16 +10,16 @@
 #include <string>
 #include <vector>
 
-#include "cli/volumes_cli.h"
 #include "fogcl/error.h"
+#include "fogcl/volumes_json.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
-    const std::vector<fogcl::FogVolume> volumes = fogcl::cli::parse_volumes_json(text, "fuzz.json");
+    const std::vector<fogcl::FogVolume> volumes = fogcl::parse_volumes_json(text, "fuzz.json");
     for (std::size_t i = 0; i < volumes.size(); ++i) fogcl::validate(volumes[i], i);
-    const std::string written = fogcl::cli::volumes_to_json(volumes);
-    if (fogcl::cli::volumes_to_json(fogcl::cli::parse_volumes_json(written, "written.json")) != written)
+    const std::string written = fogcl::volumes_to_json(volumes);
+    if (fogcl::volumes_to_json(fogcl::parse_volumes_json(written, "written.json")) != written)
       __builtin_trap();  // what the parser accepted does not read back as the same volumes
   } catch (const fogcl::Error& e) {
     if (std::strchr(e.what(), '\n') != nullptr) __builtin_trap();  // errors are one line

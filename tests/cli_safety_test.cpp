@@ -190,6 +190,150 @@ TEST_F(CliSafety, FoggingColorInPlaceStaysAllowed) {
   EXPECT_TRUE(temporaries_in(dir_).empty());
 }
 
+// The whole sequence before its first frame: an output of one frame that is the input of another
+// frame (by name, symbolic link, hard link, or a link not yet resolvable), or two outputs that are
+// one file, refuse the run in one line naming both files, and nothing is read or written.
+TEST_F(CliSafety, ASequenceOutputThatIsAnotherFramesFileIsRefusedBeforeAnyFrame) {
+  fs::create_directories(path("seq"));
+  const auto in = [&](const std::string& name) { return path("seq/" + name); };
+  for (int f = 1; f <= 10; ++f) {
+    char num[8];
+    std::snprintf(num, sizeof num, "%04d", f);
+    fs::copy_file(path("color.exr"), in("color." + std::string(num) + ".exr"));
+    fs::copy_file(path("depth.exr"), in("depth." + std::string(num) + ".exr"));
+  }
+  fs::create_symlink("color.0002.exr", in("x.0001.exr"));  // frame 1's output would be frame 2's input
+  fs::create_hard_link(in("depth.0005.exr"), in("h.0003.exr"));
+  write_text(in("o.0001.exr"), "an earlier output");
+  fs::create_symlink("o.0001.exr", in("o.0002.exr"));   // two frames, one output file
+  fs::copy_file(path("depth.exr"), in("dm.0001.exr"));  // dm.0002.exr does not exist yet
+  fs::create_symlink("dm.0002.exr", in("n.0001.exr"));
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {" --out " + in("color.%03d0.exr"), "frame 1: --out '" + in("color.0010.exr") + "' is the same file as --color '" +
+                                              in("color.0010.exr") + "' of frame 10: writing it would replace that input"},
+      {" --frames 1-2 --out " + in("x.####.exr"),
+       "frame 1: --out '" + in("x.0001.exr") + "' is the same file as --color '" + in("color.0002.exr") + "' of frame 2"},
+      {" --out " + in("h.####.exr"),
+       "frame 3: --out '" + in("h.0003.exr") + "' is the same file as --depth '" + in("depth.0005.exr") + "' of frame 5"},
+      {" --frames 1-2 --out " + in("o.####.exr"), "frame 2: --out '" + in("o.0002.exr") + "' is the same file as --out '" +
+                                                       in("o.0001.exr") + "' of frame 1: one output would replace the other"},
+      {" --out " + in("q.####.exr") + " --png " + in("q.%03d0.exr"),
+       "frame 10: --out '" + in("q.0010.exr") + "' is the same file as --png '" + in("q.0010.exr") + "' of frame 1"},
+      {" --out " + in("p.####.exr") + " --png " + in("p.%04d.exr"),
+       "frame 1: --png '" + in("p.0001.exr") + "' is the same file as --out '" + in("p.0001.exr") + "'"},
+      // A file that does not exist yet: frame 1 would create the depth file frame 2 then reads.
+      {" --frames 1-2 --out " + in("n.####.exr") + " --depth " + in("dm.####.exr") + " --color " + in("color.####.exr"),
+       "frame 1: --out '" + in("n.0001.exr") + "' is the same file as --depth '" + in("dm.0002.exr") + "' of frame 2"},
+      // A --depth without placeholder is every frame's input: no frame may fog it in place.
+      {" --frames 1-2 --out " + in("color.####.exr") + " --depth " + in("color.0002.exr") + " --color " +
+           in("color.####.exr"),
+       "frame 2: --out '" + in("color.0002.exr") + "' is the same file as --depth '" + in("color.0002.exr") +
+           "' (read by every frame)"},
+  };
+  std::vector<std::pair<std::string, std::string>> before;
+  for (const auto& e : fs::directory_iterator(path("seq")))
+    before.push_back({e.path().filename().string(), fs::is_symlink(e.symlink_status()) ? "link" : read_text(e.path())});
+  std::sort(before.begin(), before.end());
+  for (const auto& c : cases) {
+    // A case with its own --depth gives its --color too.
+    const std::string files = c.args.find(" --depth ") != std::string::npos
+                                  ? std::string()
+                                  : " --color " + in("color.####.exr") + " --depth " + in("depth.####.exr");
+    const CliRun r = run_cli("apply" + files + kFog + c.args);
+    std::printf("[ refused  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+    std::vector<std::pair<std::string, std::string>> after;
+    for (const auto& e : fs::directory_iterator(path("seq")))
+      after.push_back({e.path().filename().string(), fs::is_symlink(e.symlink_status()) ? "link" : read_text(e.path())});
+    std::sort(after.begin(), after.end());
+    EXPECT_TRUE(after == before) << c.args << ": a file of the folder was written, replaced or created";
+  }
+}
+
+// Fogging each frame in place stays allowed, and gives the bytes of a run into other files.
+TEST_F(CliSafety, ASequenceFoggedInPlaceGivesTheBytesOfARunIntoOtherFiles) {
+  for (int f = 1; f <= 3; ++f) {
+    const std::string n = "000" + std::to_string(f);
+    fs::copy_file(path("color.exr"), path("c." + n + ".exr"));
+    fs::copy_file(path("depth.exr"), path("d." + n + ".exr"));
+  }
+  const std::string seq = "apply --color " + path("c.####.exr") + " --depth " + path("d.####.exr") + kFog;
+  CliRun r = run_cli(seq + " --out " + path("ref.####.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run_cli(seq + " --out " + path("c.%04d.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (int f = 1; f <= 3; ++f) {
+    const std::string n = "000" + std::to_string(f);
+    const std::string fogged = read_text(path("c." + n + ".exr"));
+    EXPECT_NE(fogged, read_text(path("color.exr"))) << "frame " << f << " was not fogged";
+    EXPECT_TRUE(fogged == read_text(path("ref." + n + ".exr"))) << "frame " << f << " differs from its fog into ref";
+  }
+  EXPECT_TRUE(temporaries_in(dir_).empty());
+}
+
+// Inputs that are not regular files (a character device, a directory, a FIFO) are refused before
+// they are opened, in one line naming the flag, the file and what it is. The runs have a time
+// limit so that a FIFO opened by mistake fails the test instead of hanging it.
+TEST_F(CliSafety, AnInputThatIsNotARegularFileIsRefusedBeforeItIsOpened) {
+  ASSERT_EQ(::mkfifo(path("in.fifo").c_str(), 0644), 0);
+  fs::create_directories(path("in-folder"));
+  fs::create_directories(path("seq"));
+  fs::copy_file(path("color.exr"), path("seq/c.0001.exr"));
+  ASSERT_EQ(::mkfifo(path("seq/c.0002.exr").c_str(), 0644), 0);
+  const std::string pose = " --eye 0,1.6,-6 --forward 0,0,1 --up 0,1,0";
+  const std::string out = " --out " + path("o.exr");
+  const struct {
+    std::string args, says;
+  } cases[] = {
+      {"apply --color /dev/zero" + kFog + out, "--color '/dev/zero': is a character device, not a regular file"},
+      {"apply --color " + path("in.fifo") + kFog + out, "--color '" + path("in.fifo") + "': is a FIFO (named pipe), not a regular file"},
+      {"apply --color " + path("in-folder") + kFog + out, "--color '" + path("in-folder") + "': is a directory"},
+      {apply("--volumes /dev/zero" + pose + out), "--volumes '/dev/zero': is a character device, not a regular file"},
+      {apply("--volumes " + path("in.fifo") + pose + out), "--volumes '" + path("in.fifo") + "': is a FIFO (named pipe)"},
+      {apply("--volumes " + path("in-folder") + pose + out), "--volumes '" + path("in-folder") + "': is a directory"},
+      {"apply --color " + path("color.exr") + " --depth " + path("in.fifo") + kFog + out, "--depth '" + path("in.fifo") + "': is a FIFO"},
+      {"apply --color " + path("seq/c.####.exr") + " --depth " + path("depth.exr") + kFog + " --out " + path("seq/o.####.exr"),
+       "frame 2: --color '" + path("seq/c.0002.exr") + "': is a FIFO (named pipe), not a regular file"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run_cli(c.args, "timeout -s KILL 120");
+    std::printf("[ refused  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(lines(r.output), 1) << c.args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(c.says), std::string::npos) << c.args << "\n" << r.output;
+  }
+  EXPECT_FALSE(fs::exists(path("o.exr")));
+}
+
+// The library's reader refuses a FIFO without opening it. A writer waits on the FIFO meanwhile, so
+// a reader that opened it would get an empty stream (and another message) instead of hanging; the
+// writer is then released by opening the read end here.
+TEST_F(CliSafety, TheExrReaderRefusesAFifoWithoutOpeningIt) {
+  const std::string fifo = path("r.fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  std::thread writer([&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);  // blocks until a reader opens
+    if (fd >= 0) ::close(fd);
+  });
+  std::string message;
+  try {
+    read_exr(fifo, ExrReadRequest{});
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  const int release = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  writer.join();
+  if (release >= 0) ::close(release);
+  std::printf("[ fifo     ] %s\n", message.c_str());
+  EXPECT_EQ(message, fifo + ": cannot read EXR: it is a FIFO (named pipe), not a regular file");
+}
+
 // A destination that exists and is not a regular file is refused, never replaced.
 TEST_F(CliSafety, ADestinationThatIsNotARegularFileIsRefused) {
   ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0644), 0);

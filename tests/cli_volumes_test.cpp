@@ -9,12 +9,14 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 
 #include "fogcl/demo_scene.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/volume_pass.h"
 #include "fogcl/volume_scalar.h"
+#include "fogcl/volumes_json.h"
 #include "test_support.h"
 
 namespace fogcl::test {
@@ -440,6 +442,62 @@ TEST_F(CliVolumes, BadVolumesJsonIsOneLineNamingVolumeKeyAndRule) {
   }
   const std::string args = base_args({{"--volumes", in("no-such.json")}}) + " --device scalar";
   expect_rejected(args, in("bad.exr"), {"missing file", "", {"no-such.json", "cannot open"}});
+}
+
+// The library reads VOLUMES.json as the command line does (fogcl/volumes_json.h): random volumes
+// written by volumes_to_json read back as the same floats, and for files made bad by random byte
+// changes the CLI's line is "fogcl: error: " and the library's message, word for word.
+TEST_F(CliVolumes, TheLibraryReadsVolumesJsonAsTheCommandLineDoes) {
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const auto unit3 = [&] { return glm::vec3(u(rng), u(rng), u(rng)); };
+  int round_trips = 0;
+  for (int i = 0; i < 200; ++i) {
+    std::vector<FogVolume> volumes = demo_fog_volumes(i % 2 == 0 ? VolumeIntegrator::stylized : VolumeIntegrator::physical);
+    for (FogVolume& v : volumes) {
+      v.center = 100.0f * unit3() - glm::vec3(50.0f);
+      v.radius = 0.01f + 40.0f * u(rng);
+      v.density = 8.0f * u(rng);
+      v.fog_color = glm::vec4(unit3(), u(rng));
+      v.tiling = 0.01f + unit3();
+      if (u(rng) < 0.5f) v.albedo = unit3();
+    }
+    const std::string path = in("random.json");
+    write_text(path, volumes_to_json(volumes));
+    const std::vector<FogVolume> back = read_volumes_json(path);
+    ASSERT_EQ(back.size(), volumes.size());
+    for (std::size_t k = 0; k < back.size(); ++k) {
+      EXPECT_EQ(std::memcmp(&back[k].center, &volumes[k].center, sizeof(glm::vec3)), 0) << i;
+      EXPECT_EQ(back[k].radius, volumes[k].radius) << i;
+      EXPECT_EQ(back[k].density, volumes[k].density) << i;
+      EXPECT_EQ(back[k].albedo.has_value(), volumes[k].albedo.has_value()) << i;
+    }
+    EXPECT_EQ(volumes_to_json(back), volumes_to_json(volumes)) << i;
+    ++round_trips;
+  }
+  int compared = 0;
+  const std::string good = volumes_to_json(test_volumes());
+  for (int i = 0; compared < 25 && i < 400; ++i) {
+    std::string bad = good;
+    std::uniform_int_distribution<std::size_t> at(0, bad.size() - 1);
+    for (int k = 0; k < 1 + i % 3; ++k) bad[at(rng)] = "{}[],:\"0-e.x\" "[at(rng) % 13];
+    const std::string path = in("mutated.json");
+    write_text(path, bad);
+    std::string library;
+    try {
+      read_volumes_json(path);
+      continue;  // still valid volumes
+    } catch (const Error& e) {
+      library = e.what();
+    }
+    const CliRun r = run_cli(base_args({{"--volumes", path}}) + " --device scalar --out " + in("mutated.exr"));
+    EXPECT_EQ(r.output, "fogcl: error: " + library + "\n") << bad;
+    EXPECT_EQ(r.exit_code, 1);
+    ++compared;
+  }
+  std::printf("[ library  ] %d round trips bit for bit; %d bad files, the CLI's line is the library's message\n",
+              round_trips, compared);
+  EXPECT_GE(compared, 10);
 }
 
 TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {

@@ -30,6 +30,7 @@
 #include "cli/sequence.h"
 #include "exr_fixtures.h"
 #include "fogcl/exr_io.h"
+#include "fogcl/volumes_json.h"
 #include "runtime/clhpp.h"
 #include "test_support.h"
 
@@ -64,11 +65,12 @@ struct MeasuredRun {
   int lines() const { return int(std::count(output.begin(), output.end(), '\n')); }
 };
 
-MeasuredRun run_measured(const std::string& args) {
+MeasuredRun run_measured(const std::string& args, const std::string& limit_kib = std::to_string(4l << 20)) {
 #ifdef FOGCL_TEST_ASAN
   const std::string limit;
+  (void)limit_kib;
 #else
-  const std::string limit = "ulimit -v " + std::to_string(4l << 20) + "; ";
+  const std::string limit = "ulimit -v " + limit_kib + "; ";
 #endif
   const std::vector<std::string> argv_text = {"/bin/sh", "-c", limit + "exec " + cli_path() + " " + args + " 2>&1"};
   std::vector<char*> argv;
@@ -496,6 +498,98 @@ TEST_F(InputLimits, GapsInASequenceOnDiskAreNamed) {
   std::printf("[ gaps     ] %s", r.output.c_str());
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
   EXPECT_MSG_HAS(r.output, "missing frames 3, 6-8, 10, 12, 14, 16, 18, 20, ... (19 more ranges) (29 of 59 frames");
+}
+
+// ---- VOLUMES.json: a regular file of at most 64 MiB, checked before it is read -----------------------
+
+// /dev/zero grew the text until memory ran out; a 100 MiB (sparse) file was read whole. Both are
+// refused from what the file is, in bounded memory, naming the file; a file just under the limit
+// is read (and refused by the parser, from its content).
+TEST_F(InputLimits, AVolumesFileThatIsNotARegularFileOrTooLargeIsRefusedBeforeItIsRead) {
+  write_frame("frame.exr", box(0, 0, 15, 8), box(0, 0, 15, 8));
+  const auto run = [&](const std::string& volumes) {
+    return run_measured("apply --color " + path("frame.exr") + kFog + " --volumes " + volumes +
+                        " --eye 0,1,0 --forward 0,0,1 --up 0,1,0 --out " + path("out.exr"));
+  };
+  MeasuredRun r = run("/dev/zero");
+  std::printf("[ /dev/zero] exit %d, peak %.0f MiB: %s", r.exit_code, r.peak_mib, r.output.c_str());
+  expect_refused_before_allocation(r, "fogcl: error: --volumes '/dev/zero': is a character device, not a regular file");
+
+  std::ofstream(path("big.json")) << R"({"volumes": [{"center": [0, 1, 0], "radius": 2}]})";
+  fs::resize_file(path("big.json"), std::uintmax_t(100) << 20);  // sparse: 100 MiB that cost no disk
+  r = run(path("big.json"));
+  std::printf("[ 100 MiB  ] exit %d, peak %.0f MiB: %s", r.exit_code, r.peak_mib, r.output.c_str());
+  expect_refused_before_allocation(r, "fogcl: error: " + path("big.json") +
+                                          ": the volumes file (--volumes) is 104857600 bytes, more than the 67108864 "
+                                          "bytes (64 MiB) a VOLUMES.json may be");
+  fs::resize_file(path("big.json"), kMaxVolumesJsonBytes + 1);
+  r = run(path("big.json"));
+  EXPECT_MSG_HAS(r.output, "is 67108865 bytes, more than the 67108864 bytes (64 MiB)");
+  // The limit itself is read: the volume, then spaces up to 64 MiB.
+  const std::string volume = R"({"volumes": [{"center": [0, 1, 0], "radius": 2}]})";
+  std::ofstream(path("big.json"), std::ios::trunc)
+      << volume << std::string(std::size_t(kMaxVolumesJsonBytes) - volume.size(), ' ');
+  ASSERT_EQ(fs::file_size(path("big.json")), kMaxVolumesJsonBytes);
+  r = run(path("big.json"));
+  std::printf("[ 64 MiB   ] exit %d, peak %.0f MiB: %s\n", r.exit_code, r.peak_mib, r.output.c_str());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(path("out.exr")));
+}
+
+// ---- fogcl demo: its size against --max-memory, before anything is allocated ------------------------
+
+// 16384x16384 is in --width / --height's range, and took std::bad_alloc before any check: the
+// scene's plan is checked first, with --max-memory's grammar and default.
+TEST_F(InputLimits, ADemoLargerThanTheMemoryLimitIsRefusedBeforeItRenders) {
+  const cli::FrameMemoryPlan plan = cli::demo_memory(16384, 16384);
+  EXPECT_EQ(plan.total(), 16384ull * 16384 * 353);
+  MeasuredRun r = run_measured("demo --width 16384 --height 16384 --max-memory 8G --out " + path("demo"));
+  std::printf("[ demo 16K ] exit %d, peak %.0f MiB: %s", r.exit_code, r.peak_mib, r.output.c_str());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.lines(), 1) << r.output;
+  EXPECT_MSG_HAS(r.output, "fogcl: error: a 16384x16384 scene needs about 88.2 GiB (scenes 10.0 GiB, float64 "
+                           "references 62.0 GiB, fogged frames 8.00 GiB, volume buffers 6.25 GiB, preview 2.00 GiB), "
+                           "more than 8.00 GiB (--max-memory 8G)");
+  EXPECT_LT(r.peak_mib, 200.0);
+  EXPECT_FALSE(fs::exists(path("demo"))) << "the output folder was made before the check";
+  // The default limit: half of the machine's memory.
+  std::string source;
+  if (plan.total() > cli::machine_memory(&source) / 2) {
+    r = run_measured("demo --width 16384 --height 16384 --out " + path("demo"));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_MSG_HAS(r.output, "(the default --max-memory, half of the ");
+    EXPECT_FALSE(fs::exists(path("demo")));
+  }
+  // The boundary: 64x36 (813 KiB) runs under --max-memory 1M, 64x48 (1.03 MiB) is refused.
+  r = run_measured("demo --width 64 --height 48 --device scalar --max-memory 1M --out " + path("demo"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_MSG_HAS(r.output, "a 64x48 scene needs about 1.03 MiB");
+  r = run_measured("demo --width 64 --height 36 --device scalar --max-memory 1M --out " + path("demo"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(path("demo/scene.exr")));
+  std::printf("[ demo 64  ] plan %s, peak of the run %.0f MiB\n", cli::memory_text(cli::demo_memory(64, 36).total()).c_str(),
+              r.peak_mib);
+}
+
+// ---- Allocations that fail anyway: one line naming what, never std::bad_alloc ------------------------
+
+// An 8192x8192 frame is within --max-memory 64G but not within the run's 2 GiB of address space:
+// reading it takes 1.25 GiB, fogging it another 1 GiB. The failed allocation is named.
+TEST_F(InputLimits, AnAllocationThatFailsNamesWhatWasBeingAllocated) {
+#ifdef FOGCL_TEST_ASAN
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space: no limit to run under";
+#endif
+  write_frame("frame.exr", box(0, 0, 8191, 8191), box(0, 0, 7, 5));
+  const MeasuredRun r = run_measured("apply --color " + path("frame.exr") + kFog + " --max-memory 64G --out " +
+                                         path("out.exr"),
+                                     std::to_string(2l << 20));
+  std::printf("[ 8192^2   ] exit %d, peak %.0f MiB: %s", r.exit_code, r.peak_mib, r.output.c_str());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.lines(), 1) << r.output;
+  EXPECT_EQ(r.output.find("bad_alloc"), std::string::npos) << r.output;
+  EXPECT_MSG_HAS(r.output, "fogcl: error: out of memory ");
+  EXPECT_MSG_HAS(r.output, path("frame.exr"));
+  EXPECT_FALSE(fs::exists(path("out.exr")));
 }
 
 // ---- VOLUMES.json nested 100 000 deep ---------------------------------------------------------------

@@ -65,6 +65,14 @@ get_filename_component(libdir ${libdir} DIRECTORY)
 file(GLOB shared_libs ${libdir}/libfogcl.so ${libdir}/libfogcl_io.so)
 list(LENGTH shared_libs n_shared)
 message("installed: ${headers}; shared libraries: ${shared_libs}")
+# nlohmann-json is fogcl::io's build dependency only: no installed file may ask consumers for it.
+file(GLOB_RECURSE package_files ${fogcl_dir}/*.cmake ${prefix}/include/*.h)
+foreach(f IN LISTS package_files)
+  file(READ ${f} text)
+  if(text MATCHES "nlohmann")
+    message(FATAL_ERROR "${f} names nlohmann-json, a private build dependency of fogcl::io")
+  endif()
+endforeach()
 
 # ---- 2. Every installed header, no OpenCL macro, -Wall -Wextra -Wpedantic: not a word ----
 set(includes "")

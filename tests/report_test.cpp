@@ -170,6 +170,29 @@ TEST(ErrorBudget, PicksTheFastestCachesAndRefusesTheImpossible) {
   EXPECT_EQ(budget_measurements(), before + 2);
 }
 
+// A cache that cannot be written (its name taken by a directory) costs a warning and a measurement
+// next time, and leaves no temporary behind (it was left as NAME.csv.tmpPID).
+TEST(ErrorBudget, ACacheThatCannotBeWrittenLeavesNoTemporary) {
+  FOGCL_REQUIRE_DEVICE();
+  BudgetOptions o;
+  o.cache_dir = fresh_dir("budget-cache-blocked");
+  o.measure = ReportOptions{24, 14, 7, false};
+  const PrecisionChoice first = choose_precision_detailed(*runtime(), ColorFormat::rgba32f, 1e9, o);
+  ASSERT_TRUE(fs::exists(first.cache_file));
+  fs::remove(first.cache_file);
+  fs::create_directories(first.cache_file + "/in-the-way");
+  for (int run = 0; run < 2; ++run) {
+    const PrecisionChoice c = choose_precision_detailed(*runtime(), ColorFormat::rgba32f, 1e9, o);
+    EXPECT_FALSE(c.from_cache) << "nothing could have been cached";
+  }
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(o.cache_dir)) left.push_back(e.path().filename().string());
+  std::printf("[ blocked  ] the cache folder holds: %s\n", left.empty() ? "nothing" : left.front().c_str());
+  EXPECT_EQ(left, std::vector<std::string>{fs::path(first.cache_file).filename().string()})
+      << "a temporary was left next to the cache";
+  EXPECT_TRUE(fs::is_directory(first.cache_file + "/in-the-way"));
+}
+
 // --- CLI ---------------------------------------------------------------------------------------
 
 

@@ -51,6 +51,24 @@ void check_frame_files(const ApplyOptions& o, const FramePaths& p) {
               {{"--out", p.out}, {"--png", p.png}});
 }
 
+// Every output of the run against every input of the run and every other output, before the first
+// frame is read (cli/file_checks.h): a frame's own check cannot see frame 1's output replacing frame
+// 10's input.
+void check_sequence_outputs(const ApplyOptions& o, const FramePattern& color, const FramePattern& depth,
+                            const FramePattern& out, const FramePattern& png, const std::vector<int>& frames) {
+  std::vector<FrameFile> inputs = {{"--volumes", FrameFile::kEveryFrame, o.volumes.volumes_path},
+                                   {"--shadow-map", FrameFile::kEveryFrame, o.volumes.shadow_map_path}};
+  if (!depth.is_sequence) inputs.push_back({"--depth", FrameFile::kEveryFrame, o.depth_path});
+  std::vector<FrameFile> outputs;
+  for (int f : frames) {
+    inputs.push_back({"--color", f, frame_path(color, f)});
+    if (depth.is_sequence) inputs.push_back({"--depth", f, frame_path(depth, f)});
+    outputs.push_back({"--out", f, frame_path(out, f)});
+    if (!o.png_path.empty()) outputs.push_back({"--png", f, frame_path(png, f)});
+  }
+  check_sequence_files(inputs, outputs);
+}
+
 // The camera of one frame: flags win over the color file's worldToNDC / worldToCamera.
 PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std::string* from) {
   PerspectiveCamera camera;
@@ -303,7 +321,8 @@ std::string open_devices(const ApplyOptions& o, std::promise<std::shared_ptr<Dev
                          const std::function<void(Devices&)>& prepare = {}) {
   try {
     auto start = std::chrono::steady_clock::now();
-    auto devices = std::make_shared<Devices>(o);
+    auto devices = naming_allocations("opening the device and loading the volume inputs", "",
+                                      [&] { return std::make_shared<Devices>(o); });
     const auto seconds_since = [&] {
       const auto now = std::chrono::steady_clock::now();
       const double s = std::chrono::duration<double>(now - start).count();
@@ -481,6 +500,7 @@ int sweep_stale_temporaries(const FramePattern& pattern) {
 }  // namespace
 
 int run_apply(const ApplyOptions& o) {
+  set_memory_stage("checking the options and the files");
   parse_depth_kind(o.depth_kind);  // a bad kind fails before any file is touched
   const MemoryLimit memory = memory_limit(o.max_memory);  // so does a bad --max-memory
   if (o.fov != 0.0f && o.ortho_size != 0.0f)
@@ -518,14 +538,19 @@ int run_apply(const ApplyOptions& o) {
     check_frame_files(o, job.paths);  // before anything is read or written
     const int swept = detail::remove_stale_temporaries_of({o.out_path, o.png_path});
     if (o.verbose && swept > 0) std::fprintf(stderr, "removed %d stale temporary file(s) of killed runs\n", swept);
-    std::future<void> reading = std::async(std::launch::async, [&] { read_frame(o, memory, job); });
+    set_memory_stage("fogging the frame");
+    const std::string hint = frame_memory_hint(memory);
+    std::future<void> reading = std::async(std::launch::async, [&] {
+      naming_allocations("reading '" + job.paths.color + "'", hint, [&] { read_frame(o, memory, job); });
+    });
     std::promise<std::shared_ptr<Devices>> opened;
     open_devices(o, opened);
     reading.get();  // a bad input is named whether or not the device opened
     const std::shared_ptr<Devices> devices = opened.get_future().get();
-    fog_frame(o, devices->backend, job, o.verbose, devices->volumes.get(), -1);
+    naming_allocations("fogging '" + job.paths.color + "'", hint,
+                       [&] { fog_frame(o, devices->backend, job, o.verbose, devices->volumes.get(), -1); });
     take_inputs(job);
-    write_frame(o, job);
+    naming_allocations("writing '" + job.paths.out + "'", hint, [&] { write_frame(o, job); });
     return 0;
   }
 
@@ -553,6 +578,7 @@ int run_apply(const ApplyOptions& o) {
   check_files({{"--depth", depth.is_sequence ? "" : o.depth_path}, {"--volumes", o.volumes.volumes_path},
                {"--shadow-map", o.volumes.shadow_map_path}},
               {});
+  check_sequence_outputs(o, color, depth, out, png, frames);
   const int swept = sweep_stale_temporaries(out) + (o.png_path.empty() ? 0 : sweep_stale_temporaries(png));
   // One device, one context, one program cache for every frame: opened by the pipeline's start
   // (this thread) while the first frames go through, taken by the fog stage when it needs it
@@ -579,6 +605,8 @@ int run_apply(const ApplyOptions& o) {
     if (swept > 0) std::fprintf(stderr, "removed %d stale temporary file(s) of killed runs\n", swept);
   }
   ProgressBar progress(int(frames.size()), true);
+  const std::string frame_hint = frame_memory_hint(memory);
+  set_memory_stage("running the frame sequence");
   std::vector<std::string> failures;
   std::string stop_error;
   int written = 0, last_written = -1;
@@ -605,7 +633,7 @@ int run_apply(const ApplyOptions& o) {
     const bool first = f == frames.front();
     try {
       check_frame_files(o, job.paths);
-      read_frame(o, memory, job, &spare);
+      naming_allocations("reading '" + job.paths.color + "'", frame_hint, [&] { read_frame(o, memory, job, &spare); });
     } catch (...) {
       if (first && tiered) first_variant.set_value(std::nullopt);
       throw;
@@ -648,7 +676,9 @@ int run_apply(const ApplyOptions& o) {
     const bool first_on_device = on_device && device_frames++ == 0;
     job.out = spares.take();  // the passes reuse it when it has the frame's size and storage
     const auto start = std::chrono::steady_clock::now();
-    fog_frame(o, backend, job, o.verbose && !setup_printed, on_device ? devices->volumes.get() : nullptr, job.frame);
+    naming_allocations("fogging '" + job.paths.color + "'", frame_hint, [&] {
+      fog_frame(o, backend, job, o.verbose && !setup_printed, on_device ? devices->volumes.get() : nullptr, job.frame);
+    });
     const double passes_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (o.verbose && first_on_device) {
       if (scalar_frames == 0)
@@ -668,7 +698,7 @@ int run_apply(const ApplyOptions& o) {
     setup_printed = true;
   };
   stages.write = [&](FrameJob& job) {
-    write_frame(o, job);
+    naming_allocations("writing '" + job.paths.out + "'", frame_hint, [&] { write_frame(o, job); });
     spares.give(std::move(job.out));
   };
   stages.done = [&](const FrameJob& job) {

@@ -40,6 +40,7 @@ struct DemoOptions {
   int width = 1280;
   int height = 720;
   std::string device;
+  std::string max_memory;  // --max-memory: "" = half of the machine's memory (cli/frame_memory.h)
 };
 int run_demo(const DemoOptions& options);
 

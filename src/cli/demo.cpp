@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli/cli.h"
+#include "cli/frame_memory.h"
 #include "fogcl/demo_scene.h"
 #include "fogcl/exr_io.h"
 
@@ -83,6 +84,9 @@ double median_ms(int runs, Fn&& fn) {
 
 int run_demo(const DemoOptions& o) {
   namespace fs = std::filesystem;
+  // Before anything is allocated (or the folder made): a 16384x16384 scene needs about 90 GiB.
+  check_demo_memory(o.width, o.height, memory_limit(o.max_memory));
+  set_memory_stage("rendering and fogging the demo scene");
   fs::create_directories(o.out_dir);
   const auto path = [&](const std::string& name) { return (fs::path(o.out_dir) / name).string(); };
 
@@ -129,7 +133,10 @@ int run_demo(const DemoOptions& o) {
     }
   }
   for (const DemoSetting& d : demo_settings())  // the volumetric rows; one adds this deferred fog
-    if (std::string(d.name) == "exp2-distance") run_demo_volumes(o, backends, d.settings);
+    if (std::string(d.name) == "exp2-distance") {
+      set_memory_stage("running the demo's volumetric rows");
+      run_demo_volumes(o, backends, d.settings);
+    }
   std::printf("\nwrote EXR and PNG images to %s/\n", o.out_dir.c_str());
   return 0;
 }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -184,6 +185,39 @@ void check_shadow_map_memory(const std::string& path, const ExrFrameShape& shape
               ", its device copy " + memory_text(bytes / 2) + "), more than " + memory_text(limit.bytes) + " (" +
               limit.source + ")");
 }
+
+FrameMemoryPlan demo_memory(int width, int height) {
+  const std::uint64_t pixels = std::uint64_t(std::max(width, 0)) * std::uint64_t(std::max(height, 0));
+  FrameMemoryPlan plan;
+  plan.parts.push_back({"scenes", pixels * 40});
+  plan.parts.push_back({"float64 references", pixels * 248});
+  plan.parts.push_back({"fogged frames", pixels * 32});
+  plan.parts.push_back({"volume buffers", pixels * 20 + volume_target_pixels(std::uint64_t(std::max(width, 0)),
+                                                                             std::uint64_t(std::max(height, 0)), 2) *
+                                                            20});
+  plan.parts.push_back({"preview", pixels * 8});
+  return plan;
+}
+
+void check_demo_memory(int width, int height, const MemoryLimit& limit) {
+  const FrameMemoryPlan plan = demo_memory(width, height);
+  if (plan.total() <= limit.bytes) return;
+  throw Error("a " + std::to_string(width) + "x" + std::to_string(height) + " scene needs about " +
+              memory_text(plan.total()) + " (" + plan.text() + "), more than " + memory_text(limit.bytes) + " (" +
+              limit.source + "): give a smaller --width / --height or a larger --max-memory");
+}
+
+std::string frame_memory_hint(const MemoryLimit& limit) {
+  return "the machine had less free memory than " + memory_text(limit.bytes) + " (" + limit.source +
+         "); a lower --max-memory refuses such frames before they are read";
+}
+
+namespace {
+std::atomic<const char*> g_memory_stage{"starting"};
+}  // namespace
+
+void set_memory_stage(const char* stage) { g_memory_stage.store(stage); }
+const char* memory_stage() { return g_memory_stage.load(); }
 
 void check_device_allocations(const std::string& path, const Runtime& runtime, int width, int height,
                               ColorFormat format, const FrameMemoryNeeds& needs) {

@@ -6,10 +6,12 @@
 #pragma once
 
 #include <cstdint>
+#include <new>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "fogcl/error.h"
 #include "fogcl/exr_io.h"
 #include "fogcl/image.h"
 
@@ -81,6 +83,37 @@ void check_frame_memory(const std::string& path, const ExrFrameShape& shape, con
 // The same for --shadow-map: "PATH: a WxH shadow map (display window ...) needs about SIZE (the map,
 // its device copy), more than LIMIT (source)"; the map costs 8 bytes a pixel, loaded once a run.
 void check_shadow_map_memory(const std::string& path, const ExrFrameShape& shape, const MemoryLimit& limit);
+
+// What `fogcl demo` holds at its peak for a width x height scene (P pixels), the volumetric rows':
+//   scenes              P x 40: the deferred rows' frame and the volumetric rows' (RGBA float, depth)
+//   float64 references  P x 248: four volumetric ones (RGBA, coverage, the half-resolution target
+//                       and its depth key: 50 a pixel) and the deferred fog's on one (48)
+//   fogged frames       P x 32: a row's output and the reference's frame in float
+//   volume buffers      P x 25: the scalar path's result frame and coverage, the march target
+//   preview             P x 8: the 8-bit pixels and their encoding, at most
+FrameMemoryPlan demo_memory(int width, int height);
+// Throws fogcl::Error "a WxH scene needs about SIZE (parts), more than LIMIT (source): ..." when
+// demo_memory exceeds the limit (--max-memory's, as fogcl apply's).
+void check_demo_memory(int width, int height, const MemoryLimit& limit);
+
+// Runs fn; an allocation that fails in it becomes one line naming what was being allocated,
+// "out of memory WHAT (HINT)", instead of "std::bad_alloc". For the places that allocate frames,
+// whose sizes --max-memory bounds but the machine's free memory may not cover.
+template <class Fn>
+auto naming_allocations(const std::string& what, const std::string& hint, Fn&& fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const std::bad_alloc&) {
+    throw Error("out of memory " + what + (hint.empty() ? std::string() : " (" + hint + ")"));
+  }
+}
+// The hint for a frame's buffers: the machine had less free memory than the limit allows.
+std::string frame_memory_hint(const MemoryLimit& limit);
+
+// What the main thread is doing (a string literal), for main's last resort when an allocation fails
+// where nothing nearer names it: "fogcl: error: out of memory while STAGE".
+void set_memory_stage(const char* stage);
+const char* memory_stage();
 
 // Throws fogcl::Error "PATH: a WxH FORMAT frame needs a SIZE NAME buffer ..." when one of the frame's device buffers
 // (color, depth, output; the volume target) is larger than the device's CL_DEVICE_MAX_MEM_ALLOC_SIZE, which the OpenCL

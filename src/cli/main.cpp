@@ -3,11 +3,13 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <new>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.h"
+#include "cli/frame_memory.h"
 #include "cli/usage.h"
 #include "io/atomic_file.h"
 
@@ -43,6 +45,9 @@ int main(int argc, char** argv) {
   demo_cmd->add_option("--width", demo.width, "Image width [pixels]")->check(kPixels)->capture_default_str();
   demo_cmd->add_option("--height", demo.height, "Image height [pixels]")->check(kPixels)->capture_default_str();
   demo_cmd->add_option("--device", demo.device, kDeviceHelp);
+  demo_cmd->add_option("--max-memory", demo.max_memory,
+                       "Refuse a scene whose size needs more memory than this (the frames and their float64 "
+                       "references), e.g. 8G or 512M (binary units; default: half of the machine's memory)");
 
   fogcl::cli::ApplyOptions ap;
   std::string mode = "exp2", precision = "precise";
@@ -185,6 +190,7 @@ int main(int argc, char** argv) {
   try {
     if (*demo_cmd) return fogcl::cli::run_demo(demo);
     if (*report_cmd) {
+      fogcl::cli::set_memory_stage("measuring the report");
       if (report.runs > 1000) throw fogcl::Error("--runs must be <= 1000 (got " + std::to_string(report.runs) + ")");
       if (report.volumetric) {  // its own defaults: the 4096-step references must take seconds
         if (report_cmd->count("--width") == 0) report.width = 160;
@@ -235,6 +241,9 @@ int main(int argc, char** argv) {
   } catch (const fogcl::cli::UsageError& e) {
     std::fprintf(stderr, "fogcl: error: %s\n", e.what());
     return fogcl::cli::kExitUsage;
+  } catch (const std::bad_alloc&) {  // the last resort: the places that allocate frames name them
+    std::fprintf(stderr, "fogcl: error: out of memory while %s\n", fogcl::cli::memory_stage());
+    return fogcl::cli::kExitError;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "fogcl: error: %s\n", e.what());
     return fogcl::cli::kExitError;

@@ -15,6 +15,7 @@
 #include "fogcl/renderer_camera.h"
 #include "fogcl/volume_pass.h"
 #include "fogcl/volumes.h"
+#include "fogcl/volumes_json.h"
 
 namespace CLI {
 class App;
@@ -52,17 +53,8 @@ void add_volume_options(CLI::App& apply, VolumeCliOptions& o);
 // After parsing: records which volume flags were given (their defaults depend on it).
 void note_given_volume_flags(const CLI::App& apply, VolumeCliOptions& o);
 
-// VOLUMES.json (docs/cli.md#volumesjson): {"volumes": [{"center": [x, y, z], "radius": r, ...}]},
-// each key a FogVolume field in snake_case. Throws fogcl::Error, one line: "NAME: volume I: 'KEY'
-// RULE (got VALUE)" for a wrong value, "NAME: ...: parse error at line L, column C: ..." for
-// malformed JSON. Every volume also passes fogcl::validate(). One key that is not a field:
-// "medium": "homogeneous" (a plain medium: noise and fades off, albedo and ambient 0 unless given;
-// it refuses the noise and fade keys). The values are as given: VolumeStage maps them from --axes.
-std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name);
-std::vector<FogVolume> read_volumes_json(const std::string& path);
-// The inverse: every key of each volume (albedo and ambient only when set), parse_volumes_json
-// gives the same floats back.
-std::string volumes_to_json(const std::vector<FogVolume>& volumes);
+// VOLUMES.json is read by the library (fogcl/volumes_json.h: read_volumes_json, volumes_to_json).
+
 
 // "m00,m01,...,m33": 16 numbers, row-major (the first four are the first row) -> GLM's
 // column-major. Throws fogcl::Error naming --light-view-proj for a count, a non-number or a

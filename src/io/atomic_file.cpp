@@ -394,6 +394,12 @@ std::string destination_problem(const std::string& path) {
   return "";
 }
 
+std::string non_regular_kind(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return "";
+  return file_type_name(st.st_mode);
+}
+
 std::string resolved_destination(const std::string& path) {
   struct stat st {};
   if (::lstat(path.c_str(), &st) != 0 || !S_ISLNK(st.st_mode)) return path;

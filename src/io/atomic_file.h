@@ -59,6 +59,12 @@ class WriteBatch {
 // 'X', which does not exist". Follows symbolic links, as the writer does.
 std::string destination_problem(const std::string& path);
 
+// What `path` is when it exists and is not a regular file: "a directory", "a FIFO (named pipe)",
+// "a character device", "a block device", "a socket"; "" for a regular file or one that cannot be
+// found (its reader names that). Follows symbolic links. Readers that need a file's size (EXR,
+// JSON) refuse the others: a FIFO would block the open, /dev/zero never ends.
+std::string non_regular_kind(const std::string& path);
+
 // The file that write_file_atomically replaces for `path`: the file a symbolic link names (its
 // canonical path), else `path`.
 std::string resolved_destination(const std::string& path);

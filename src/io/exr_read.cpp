@@ -494,6 +494,9 @@ ExrInput read_with(const std::string& name, const ExrReadRequest& r, Open&& open
 
 ExrInput read_exr(const std::string& path, const ExrReadRequest& request) {
   return read_with(path, request, [&](Source& s) {
+    // Not opened: a FIFO would block the open, a device has no size to check the header against.
+    if (const std::string kind = detail::non_regular_kind(path); !kind.empty())
+      throw Error(path + ": cannot read EXR: it is " + kind + ", not a regular file");
     s.file_stream = std::make_unique<std::ifstream>(path, std::ios::binary);
     if (!*s.file_stream) throw Error(path + ": cannot read EXR: cannot open the file: " + std::strerror(errno));
     std::ifstream& f = *s.file_stream;

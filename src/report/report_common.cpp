@@ -191,14 +191,26 @@ std::string one_line(std::string s) {
 }
 
 void write_cache_file(const std::string& path, const std::string& text) {
-  fs::create_directories(fs::path(path).parent_path());
   const std::string tmp = path + ".tmp" + std::to_string(::getpid());
+  bool created = false;  // only a temporary this call made is removed
+  const auto fail = [&](const std::string& why) {
+    std::error_code ignored;
+    if (created) fs::remove(tmp, ignored);  // no failure leaves the temporary behind
+    return Error("cannot write the error-budget cache " + path + ": " + why);
+  };
+  std::error_code ec;
+  fs::create_directories(fs::path(path).parent_path(), ec);
+  if (ec) throw fail("cannot create its folder: " + ec.message());
   {
     std::ofstream f(tmp, std::ios::trunc);
+    if (!f) throw fail("cannot create " + tmp);
+    created = true;
     f << text;
-    if (!f.flush()) throw Error("cannot write the error-budget cache " + path);
+    if (!f.flush()) throw fail("writing " + tmp + " failed");
   }
-  fs::rename(tmp, path);  // atomic: a concurrent reader sees the old file or the new one
+  fs::rename(tmp, path, ec);  // atomic: a concurrent reader sees the old file or the new one
+  std::error_code ignored;
+  if (ec) throw fail(fs::is_directory(path, ignored) ? std::string("it is a directory") : ec.message());
 }
 
 std::string short_num(double v) {
