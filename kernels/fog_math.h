@@ -98,12 +98,15 @@ FOG_FN FOG_REAL FOG_NAME(fog_ray_term)(FOG_REAL rx, FOG_REAL ry, FOG_REAL rz, in
   return squared ? length2 : sqrt(length2);
 }
 
-/* NaN test that survives -cl-fast-relaxed-math (which may fold x != x away): the bit pattern.
+/* NaN and infinity tests that survive -cl-fast-relaxed-math (which may fold x != x, or a
+ * comparison with INFINITY, away): the bit pattern.
  * The includer of an OpenCL instance defines FOG_AS_UINT (as_uint, as_uint16). */
 #ifdef __OPENCL_C_VERSION__
 #define FOG_IS_NAN(x) ((FOG_AS_UINT(x) & 0x7fffffffu) > 0x7f800000u)
+#define FOG_IS_INF(x) ((FOG_AS_UINT(x) & 0x7fffffffu) == 0x7f800000u)
 #else
 #define FOG_IS_NAN(x) isnan(x)
+#define FOG_IS_INF(x) isinf(x)
 #endif
 
 /* Raw depth outside [0, 1] is clamped; NaN becomes the far value (sky). Two implementations,
@@ -515,11 +518,18 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_expm1_device)(FOG_REAL x, FOG_REAL* expm
  * height change times k, from the direction, never a difference of heights, which cancels), h*
  * the end where the integrand is largest: only that one is exponentiated, so nothing overflows
  * that the true value does not. falloff == 0 (k = 0): H = L. sky_infinite (a fogged sky without a
- * cut-off: s1 = +inf): H = e^(-k (h0 - b)) / (k wy) where k wy > 0, else +inf. */
+ * cut-off: s1 = +inf, whatever s1 says): H = e^(-k (h0 - b)) / (k wy) where k wy > 0, else +inf
+ * (k = 0 included). */
 FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_length)(FOG_REAL s0, FOG_REAL s1, FOG_REAL wy, FOG_REAL d0, FOG_REAL k,
                                             int falloff, FOG_INT sky_infinite) {
   FOG_REAL L = s1 - s0;
-  if (!falloff) return L;
+  /* k = 0: the integrand is 1, H = L; but the sky's ray is infinite (its s1 is only the far
+   * plane's distance, which a start or sun start may pass): H = +inf, so that T = 0 and J = 1
+   * where beta > 0, T = 1 and J = 0 where beta = 0 (fog_height_depth's 0 inf = 0). */
+  if (!falloff) return sky_infinite ? (FOG_REAL)INFINITY : L;
+  /* A surface past float's range (s1 = +inf: an infinite far plane's raw depth below near /
+   * FLT_MAX) is as far as the sky: L e G would be inf 0. */
+  sky_infinite = sky_infinite | FOG_IS_INF(s1);
   FOG_REAL kwy = k * wy;
   FOG_REAL x = kwy * L;
   FOG_REAL e0 = fma(s0, wy, d0); /* h0 - b */
@@ -532,7 +542,8 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_length)(FOG_REAL s0, FOG_REAL s1, FOG
    * a, so no series branch is needed (Unreal's switches to a Taylor series below |x| = 0.01). */
   FOG_REAL a = fabs(x);
   FOG_REAL q = (sky_infinite ? e : -FOG_EXPM1(-a)) / (sky_infinite ? kwy : a);
-  FOG_REAL h = L * e * (a == (FOG_REAL)0 ? (FOG_REAL)1 : q);
+  /* G >= FLT_MIN: G = 1 / a underflows only where a = k wy L > 2^126, where e may be +inf too. */
+  FOG_REAL h = L * e * (a == (FOG_REAL)0 ? (FOG_REAL)1 : fmax(q, (FOG_REAL)0x1p-126f));
   FOG_REAL h_inf = kwy > (FOG_REAL)0 ? q : (FOG_REAL)INFINITY;
   return sky_infinite ? h_inf : h;
 }

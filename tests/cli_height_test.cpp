@@ -131,6 +131,97 @@ TEST_F(CliHeight, VolumesFirstThenHeightFog) {
   EXPECT_EQ(differing_floats(got, want), 0u);
 }
 
+// The demo scene's far plane is at 1000; with no falloff a fogged sky is still an infinite ray
+// (docs/DESIGN.md §6.2), whatever start or sun start lies past the far plane: every sky pixel is
+// exactly the fog color, or the fog color plus the lobe (the float64 path's value within §6.3's
+// budget), no pixel is non-finite, and the CLI gives the library's bits. With --sky infinite,
+// --reversed-z, --precision fast and --pixel-type half, on the device and the scalar path.
+TEST_F(CliHeight, ZeroFalloffSkyPastTheStartIsTheFogColor) {
+  PerspectiveCamera rc;
+  rc.reversed_z = true;
+  const DemoFrame rev = render_demo_scene(64, 36, rc);
+  write_exr_rgba(in("scene-revz.exr"), rev.color);
+  write_exr_depth(in("scene-revz-depth.exr"), rev.depth);
+  struct Case {
+    std::string flags;
+    bool reversed = false, sky_infinite = false, fast = false, half = false;
+    float sun_start = -1;  // -1: no lobe
+  };
+  const Case cases[] = {
+      {""},
+      {" --sky infinite", false, true},
+      {" --reversed-z", true},
+      {" --precision fast", false, false, true},
+      {" --pixel-type half", false, false, false, true},
+      {" --light-dir 0.2,1,0.4 --sun-color 1,1,1 --sun-start 1e38", false, false, false, false, 1e38f},
+      {" --light-dir 0.2,1,0.4 --sun-color 1,1,1 --sun-start 2000 --reversed-z", true, false, false, false, 2000},
+  };
+  std::vector<std::string> devices = {"scalar"};
+  if (runtime() != nullptr && cli_device() != "scalar") devices.push_back(cli_device());
+  double worst_lobe = 0;
+  for (const Case& c : cases) {
+    const DemoFrame& frame = c.reversed ? rev : *frame_;
+    const std::string inputs = c.reversed ? "apply --color " + in("scene-revz.exr") + " --depth " + in("scene-revz-depth.exr") +
+                                                " --near 0.3 --far 1000 --fov 60"
+                                          : files();
+    FogSettings s;
+    s.mode = FogMode::height;
+    s.density = 0.5f;
+    s.height.start = 2000.0f;
+    s.fog_skybox = true;
+    s.sky = c.sky_infinite ? SkyDistance::infinite : SkyDistance::far_plane;
+    s.precision = c.fast ? Precision::fast : Precision::precise;
+    if (c.sun_start >= 0) {
+      SunLobe sun;
+      sun.direction = glm::vec3(0.2f, 1.0f, 0.4f);
+      sun.color = glm::vec3(1.0f);
+      sun.start = c.sun_start;
+      s.height.sun = sun;
+    }
+    CameraParams cam = frame.params;
+    cam.pose = pose();
+    const FogResult<double> ref = fog_scalar<double>(frame.color, frame.depth, cam, s);
+    for (const std::string& device : devices) {
+      const std::string args = inputs + pose_flags() + " --mode height --density 0.5 --start 2000 --fog-skybox" + c.flags +
+                               " --device " + device;
+      const ColorImage got = run_ok(args, "zero-falloff.exr");
+      ASSERT_EQ(got.width(), 64) << args;
+      std::size_t sky = 0, nonfinite = 0, sky_off = 0;
+      for (int y = 0; y < got.height(); ++y)
+        for (int x = 0; x < got.width(); ++x) {
+          const bool is_sky = frame.depth.at(x, y) == (c.reversed ? 0.0f : 1.0f);
+          sky += is_sky;
+          for (int k = 0; k < 3; ++k) {
+            const float g = got.pixel(x, y)[k];
+            nonfinite += !std::isfinite(g);
+            if (!is_sky) continue;
+            if (c.sun_start < 0) {
+              sky_off += g != 0.5f;
+            } else {
+              const double err = std::fabs(double(g) - ref.rgba[4 * (std::size_t(y) * 64 + x) + k]);
+              const double scale = 1 + std::fabs(frame.color.pixel(x, y)[k]) + 0.5 + 1;
+              worst_lobe = std::max(worst_lobe, std::isnan(err) ? INFINITY : err / scale);
+            }
+          }
+        }
+      std::printf("[ measured ] k = 0, start 2000, fogged sky%s on %s: %zu sky pixels, %zu sky channels not 0.5, %zu non-finite\n",
+                  c.flags.c_str(), device.c_str(), sky, sky_off, nonfinite);
+      EXPECT_GT(sky, 100u);
+      EXPECT_EQ(sky_off, 0u) << args;
+      EXPECT_EQ(nonfinite, 0u) << args;
+      if (c.half) continue;  // the library's bits in float storage
+      ColorImage want;
+      if (device == "scalar")
+        apply_fog_scalar(frame.color, frame.depth, want, cam, s);
+      else
+        shared_pass().apply(frame.color, frame.depth, want, cam, s);
+      EXPECT_EQ(differing_floats(got, want), 0u) << args;
+    }
+  }
+  std::printf("[ worst    ] the lobe's sky past a sun start of 1e38 and 2000: err %.2e of 1 + |c| + |F| + |S|\n", worst_lobe);
+  EXPECT_LE(worst_lobe, 4e-6);
+}
+
 TEST_F(CliHeight, BadInputIsOneLineNamingTheFlagAndTheRule) {
   const std::string p = pose_flags();
   struct Case {

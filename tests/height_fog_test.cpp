@@ -588,6 +588,117 @@ TEST(HeightFog, ExtremeCasesWithinBudget) {
   }
 }
 
+// §6.2 with k = 0: the fogged sky is an infinite ray too (H = +inf), never its far-plane distance,
+// which a start or a sun start may pass. Where beta > 0, T = 0 and J = 1: the sky is exactly F,
+// plus S λ with a lobe; a channel with in-scattering 0 and extinction > 0 is exactly 0, one with
+// both 0 keeps its color. 96 x 55 pixels looking up, every other pixel sky, the rest surfaces
+// (within the budget of the float64 path, finite), on every path.
+TEST(HeightFog, ZeroFalloffSkyIsInfinitelyFar) {
+  struct Case {
+    const char* name;
+    float density, start = 0;
+    glm::vec3 fog{0.5f};
+    glm::vec3 extinction{-1.0f}, inscattering{-1.0f};  // -1: unset
+    float sun_start = -1;                               // -1: no lobe
+    bool reversed = false, sky_infinite = false;
+    Precision precision = Precision::precise;
+    ColorFormat format = ColorFormat::rgba32f;
+  };
+  const Case cases[] = {
+      {"density 0.004", 0.004f},
+      {"density 0.004, a zero fog channel, per-channel extinction", 0.0f, 0, {0.5f, 0.0f, 0.25f}, {0.004f, 0.002f, 0.006f}},
+      {"in-scattering 0 in G, no coefficient in B", 0.0f, 0, {0.5f, 0.25f, 0.75f}, {0.004f, 0.003f, 0.0f},
+       {0.004f, 0.0f, 0.0f}},
+      {"density 0.5, start 2000 (past the far plane)", 0.5f, 2000},
+      {"start 2000, sky infinite", 0.5f, 2000, glm::vec3(0.5f), glm::vec3(-1.0f), glm::vec3(-1.0f), -1, false, true},
+      {"start 2000, reversed Z", 0.5f, 2000, glm::vec3(0.5f), glm::vec3(-1.0f), glm::vec3(-1.0f), -1, true},
+      {"start 2000, fast", 0.5f, 2000, glm::vec3(0.5f), glm::vec3(-1.0f), glm::vec3(-1.0f), -1, false, false,
+       Precision::fast},
+      {"start 2000, half", 0.5f, 2000, glm::vec3(0.5f), glm::vec3(-1.0f), glm::vec3(-1.0f), -1, false, false,
+       Precision::precise, ColorFormat::rgba16f},
+      {"start 2000, sun start 1e38", 0.5f, 2000, glm::vec3(0.5f), glm::vec3(-1.0f), glm::vec3(-1.0f), 1e38f},
+      {"sun start 2000, reversed Z, half, fast", 0.5f, 0, glm::vec3(0.5f), glm::vec3(-1.0f), glm::vec3(-1.0f), 2000, true,
+       false, Precision::fast, ColorFormat::rgba16f},
+  };
+  const int w = 96, h = 55;
+  double worst_sky = 0, worst_surface = 0;
+  std::size_t sky_pixels = 0, nonfinite = 0, sky_wrong = 0;
+  for (const Case& c : cases) {
+    const CameraParams cam = posed(perspective(c.reversed), {0, 2, 0}, {0.1f, 1.0f, 0.3f});
+    Frame f = make_frame(w, h, cam, c.format, 55u);
+    for (int y = 0; y < h; ++y)
+      for (int x = (y & 1); x < w; x += 2) f.depth.at(x, y) = c.reversed ? 0.0f : 1.0f;
+    FogSettings s = base_height_settings();
+    s.density = c.density;
+    s.color = c.fog;
+    s.fog_skybox = true;
+    s.sky = c.sky_infinite ? SkyDistance::infinite : SkyDistance::far_plane;
+    s.precision = c.precision;
+    s.height.start = c.start;
+    if (c.extinction.x >= 0) s.height.extinction = c.extinction;
+    if (c.inscattering.x >= 0) s.height.inscattering = c.inscattering;
+    if (c.sun_start >= 0) {
+      SunLobe sun;
+      sun.direction = glm::vec3(0.2f, 1.0f, 0.4f);
+      sun.color = glm::vec3(1.0f);
+      sun.start = c.sun_start;
+      s.height.sun = sun;
+    }
+    const Variant v = select_variant(s, cam, c.format);
+    ASSERT_EQ(v.height_features & kHeightFalloff, 0) << c.name;
+    const FogResult<double> ref = fog_scalar<double>(f.color, f.depth, cam, s);
+    std::vector<std::pair<const char*, ColorImage>> outs;
+    outs.emplace_back("scalar", ColorImage());
+    apply_fog_scalar(f.color, f.depth, outs.back().second, cam, s);
+    if (runtime() != nullptr)
+      for (const KernelPath& path : kernel_paths()) {
+        outs.emplace_back(path.name, ColorImage());
+        path.pass->apply(f.color, f.depth, outs.back().second, cam, s);
+      }
+    const glm::vec3 ext = c.extinction.x >= 0 ? c.extinction : glm::vec3(c.density);
+    const glm::vec3 in = c.inscattering.x >= 0 ? c.inscattering : ext;
+    double case_sky = 0, case_surface = 0;
+    for (const auto& [path, out] : outs)
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          const bool sky = ((x + y) & 1) == 0;
+          sky_pixels += sky;
+          const glm::vec4 got = out.pixel(x, y), color = f.color.pixel(x, y);
+          for (int k = 0; k < 3; ++k) {
+            const double r = ref.rgba[4 * (std::size_t(y) * w + x) + k];
+            const double err = std::fabs(double(got[k]) - r);
+            const double scale = 1 + std::fabs(color[k]) + std::fabs(c.fog[k]) + (c.sun_start >= 0 ? 1 : 0);
+            nonfinite += !std::isfinite(got[k]);
+            const double allow = c.format == ColorFormat::rgba16f ? half_ulp(r) / scale : 0.0;
+            if (sky) {
+              // The float64 path's sky: F J + S λ J_sun with J = J_sun = 1 (0 without in-scattering),
+              // or the color where the channel has no coefficient.
+              const double want = ext[k] == 0 && in[k] == 0 ? color[k] : in[k] == 0 ? 0.0 : c.fog[k];
+              if (c.sun_start < 0 && (r != want || got[k] != float(want)) && ++sky_wrong <= 5)
+                ADD_FAILURE() << c.name << " " << path << " at " << x << "," << y << " channel " << k << ": " << got[k]
+                              << " (float64 path " << r << "), not " << want;
+              case_sky = std::max(case_sky, std::isnan(err) ? INFINITY : err / scale - allow);
+            } else {
+              case_surface = std::max(case_surface, std::isnan(err) ? INFINITY : err / scale - allow);
+            }
+          }
+        }
+    std::printf("[ k = 0 sky] %-58s sky err %.2e, surfaces err %.2e (of 1 + |c| + |F| + |S|, beyond half's rounding)\n",
+                c.name, case_sky, case_surface);
+    // The lobe: S λ from the float32 ω and λ's polynomials, within §6.3's budget (fast: 4e-5).
+    const double budget = c.precision == Precision::fast ? 4e-5 : kBudget;
+    EXPECT_LE(case_sky, budget) << c.name;
+    EXPECT_LE(case_surface, budget) << c.name;
+    worst_sky = std::max(worst_sky, case_sky);
+    worst_surface = std::max(worst_surface, case_surface);
+  }
+  std::printf("[ worst    ] k = 0, fogged sky: %zu sky pixels, %zu sky channels not exactly F (or 0, or c), worst sky "
+              "err %.2e, surfaces %.2e, %zu non-finite\n",
+              sky_pixels, sky_wrong, worst_sky, worst_surface, nonfinite);
+  EXPECT_EQ(sky_wrong, 0u);
+  EXPECT_EQ(nonfinite, 0u);
+}
+
 // Unreal's published line integral (HeightFogCommon.ush, CalculateLineIntegralShared): the
 // falloff times the height change taken from heights, (1 - e^-x) / x, and its first-order Taylor
 // series below |x| = 0.01, exponentiated at the ray's origin; beside fogcl's closed form, both

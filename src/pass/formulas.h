@@ -20,6 +20,7 @@ using std::fma;
 using std::log1p;
 using std::fmax;
 using std::fmin;
+using std::isinf;
 using std::isnan;
 using std::sqrt;
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -26,21 +27,24 @@ template <class T>
 FogCoefficients<T> fog_coefficients(const FogSettings& s, KernelMode mode) {
   constexpr double kLog2e = 1.44269504088896340736;        // 1 / ln 2
   constexpr double kInvSqrtLn2 = 1.20112240878644803896;   // 1 / sqrt(ln 2)
+  // Held to the largest finite T: a density near FLT_MAX (or end - start under FLT_MIN) would
+  // make the factor +inf, and distance 0 times it NaN; its largest finite value gives e^0 = 1.
+  const auto finite = [](T x) { return std::fmin(x, std::numeric_limits<T>::max()); };
   FogCoefficients<T> c;
   switch (mode) {
     case KernelMode::linear:
       c.a = T(s.end);
-      c.b = T(1) / (T(s.end) - T(s.start));
+      c.b = finite(T(1) / (T(s.end) - T(s.start)));
       break;
     case KernelMode::linear_step:
       c.a = T(s.start);
       break;
     case KernelMode::exp:
-      c.a = T(s.density) * T(kLog2e);
+      c.a = finite(T(s.density) * T(kLog2e));
       c.b = T(s.density);
       break;
     case KernelMode::exp2:
-      c.a = T(s.density) * T(kInvSqrtLn2);
+      c.a = finite(T(s.density) * T(kInvSqrtLn2));
       c.b = T(s.density);
       break;
     case KernelMode::none:
