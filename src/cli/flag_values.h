@@ -179,10 +179,10 @@ inline std::vector<int> parse_step_list(const std::string& flag, const std::stri
   while (true) {
     const std::size_t comma = text.find(',', start);
     const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    if (part.empty() || part.size() > 18 || part.find_first_not_of("0123456789") != std::string::npos)
+    if (part.empty() || part.find_first_not_of("0123456789") != std::string::npos)
       throw UsageError(flag + " must be comma-separated whole numbers such as 16,32 (got '" + text + "')");
-    const long long v = std::stoll(part);
-    if (v < 1 || v > 4096) throw Error(flag + " must be in [1, 4096] each (got " + part + " in '" + text + "')");
+    const long long v = part.size() > 9 ? 0 : std::stoll(part);
+    if (v < 1 || v > 4096) throw Error(flag + " must be in [1, 4096] (got " + part + " in '" + text + "')");
     steps.push_back(int(v));
     if (comma == std::string::npos) return steps;
     start = comma + 1;
