@@ -272,7 +272,7 @@ int main(int argc, char** argv) {
         fogcl::cli::keyword_list_value("--integrators", text, kIntegrators);
       }));
 
-  CLI::App* version_cmd = app.add_subcommand("version", "Print what --version prints");
+  CLI::App* version_cmd = app.add_subcommand("version", "Print the version, the git commit it was built from and the OpenCL platforms and devices found (as --version)");
   for (CLI::App* command : {demo_cmd, apply_cmd, report_cmd, version_cmd})
     command->footer(fogcl::cli::exit_codes_help());
 
