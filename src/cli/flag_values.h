@@ -128,6 +128,7 @@ inline std::vector<std::string> keyword_list_value(const std::string& flag, cons
     try {
       check_keyword(flag, part, words);
     } catch (const Error& e) {
+      if (part == text) throw;
       throw Error(std::string(e.what()) + " in '" + text + "'");
     }
     parts.push_back(part);
