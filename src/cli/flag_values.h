@@ -8,6 +8,7 @@
 // device's name in any case. Every message names the flag and shows the value as typed.
 #pragma once
 
+#include <cctype>
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
@@ -62,11 +63,11 @@ inline const RealRule kPositive{"finite and > 0", 0.0, true};
 inline const RealRule kNonNegative{"finite and >= 0", 0.0, false};
 
 // One number as strtod reads the whole text (nan and inf are numbers, for the rules to name);
-// throws UsageError for empty text or text that is not one number.
+// throws UsageError for empty text, a leading blank (as integer flags) or text that is not one number.
 inline double read_number(const std::string& flag, const std::string& text) {
   char* end = nullptr;
   const double d = std::strtod(text.c_str(), &end);
-  if (text.empty() || end == text.c_str() || *end != '\0')
+  if (text.empty() || std::isspace(static_cast<unsigned char>(text[0])) || end == text.c_str() || *end != '\0')
     throw UsageError(flag + " must be a number (got '" + text + "')");
   return d;
 }

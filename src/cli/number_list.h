@@ -2,6 +2,7 @@
 // flags share; each flag keeps its own count, range and messages.
 #pragma once
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -22,8 +23,8 @@ struct NumberList {
 };
 
 // Each part between commas as strtod reads the whole of it (so nan, inf and 1e39 are numbers, for
-// the flag's rules to name them); stops at the first part that is empty or has anything after the
-// number.
+// the flag's rules to name them); stops at the first part that is empty, starts with a blank
+// (numbers are written without, as for single-number flags) or has anything after the number.
 inline NumberList parse_number_list(const std::string& text) {
   NumberList list;
   std::size_t start = 0;
@@ -32,7 +33,7 @@ inline NumberList parse_number_list(const std::string& text) {
     std::string part = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     char* end = nullptr;
     const double d = std::strtod(part.c_str(), &end);
-    if (part.empty() || end == part.c_str() || *end != '\0') {
+    if (part.empty() || std::isspace(static_cast<unsigned char>(part[0])) || end == part.c_str() || *end != '\0') {
       list.bad_part = std::move(part);
       return list;
     }
