@@ -356,7 +356,7 @@ struct BadCase {
   std::string what;                 // the case, for failure messages
   std::string args;                 // appended to the base arguments (or replacing them, see below)
   std::vector<std::string> expect;  // parts the message must contain
-  int code = 1;                     // 1 for a value that breaks a rule, 2 for a required flag left out
+  int code = 1;                     // 1 for a value that breaks a rule, 2 for a malformed value or a required flag left out
 };
 
 void expect_rejected(const std::string& args, const std::string& out, const BadCase& c) {
@@ -518,7 +518,7 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
       {"up parallel to forward", {{"--forward", "0,0,1"}, {"--up", "0,0,-2"}}, {"parallel", "(0, 0, -2)", "(0, 0, 1)"}},
       {"zero up", {{"--up", "0,0,0"}}, {"--up", "non-zero"}},
       {"NaN eye", {{"--eye", "0,nan,0"}}, {"--eye", "finite", "0,nan,0"}},
-      {"two numbers", {{"--forward", "0,1"}}, {"--forward", "three comma-separated numbers", "0,1"}},
+      {"two numbers", {{"--forward", "0,1"}}, {"--forward", "three comma-separated numbers", "0,1"}, 2},
       {"zero light", {{"--light-dir", "0,0,0"}}, {"--light-dir", "non-zero"}},
       {"negative light", {{"--light-color", "1,-1,1"}}, {"--light-color", ">= 0"}},
       {"missing --eye", {{"--eye", ""}}, {"--eye is required with --volumes"}, 2},
@@ -544,10 +544,12 @@ TEST_F(CliVolumes, BadCameraLightAndShadowInputIsOneLineNamingTheValue) {
       {"light matrix singular", shadow + singular, {"--light-view-proj", "singular", "determinant"}},
       {"light matrix 15 numbers",
        shadow + matrix_.substr(0, matrix_.rfind(',')),
-       {"--light-view-proj", "16", "got 15"}},
+       {"--light-view-proj", "16", "got 15"},
+       2},
       {"light matrix word",
        shadow + "a" + matrix_.substr(matrix_.find(',')),
-       {"--light-view-proj", "element 0", "'a'"}},
+       {"--light-view-proj", "element 0", "'a'"},
+       2},
       {"shadow map unreadable",
        " --shadow-map " + in("not-an-exr.exr") + " --light-view-proj " + matrix_,
        {"--shadow-map", "not-an-exr.exr"}},

@@ -366,7 +366,7 @@ TEST_F(RendererExr, BadFilesExitNonZeroWithOneLineAndNoOutput) {
       {"--color " + path("good.exr") + " --depth-channel depth.Z", "no depth channel 'depth.Z'"},
       {"--color " + path("good.exr") + " --depth " + path("window.exr"), "window differs"},
       {"--color " + path("good.exr") + " --depth " + path("size.exr"), "window differs"},
-      {"--color " + path("good.exr") + " --depth-kind linear", "depth kind must be raw, eye or distance (got 'linear')"},
+      {"--color " + path("good.exr") + " --depth-kind linear", "--depth-kind must be one of raw, eye or distance (got 'linear')"},
   };
   for (const auto& c : cases) {
     const CliRun r = run_cli("apply " + c.args + " --fov 50 --device scalar --out " + path("out.exr") +

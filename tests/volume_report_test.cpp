@@ -304,9 +304,10 @@ TEST(VolumeReportCli, BadFlagsAreOneLineErrors) {
     std::string args, expect;
   } cases[] = {
       {"--volumetric --device scalar", "the scalar path (--device scalar) has none"},
-      {"--volumetric --integrators riemann", "--integrators: 'riemann' is not one of stylized, physical"},
-      {"--volumetric --runs 2 --device " + cli_device(), "runs must be >= 3 for a median (got 2)"},
-      {"--volumetric --scenes fog --device " + cli_device(), "scene 'fog' is not one of demo, dense, thin, inside"},
+      {"--volumetric --integrators riemann", "--integrators must be one of stylized or physical (got 'riemann')"},
+      {"--volumetric --runs 2 --device " + cli_device(), "--runs must be >= 3 with --volumetric (got 2)"},
+      {"--volumetric --scenes fog,dense --device " + cli_device(),
+       "--scenes must be one of demo, dense, thin or inside (got 'fog') in 'fog,dense'"},
       {"--steps 8", "--steps selects volumetric variants; it needs --volumetric"},
       {"--runs 5", "--runs must be >= 7 for the deferred report (got 5)"},
   };

@@ -103,9 +103,25 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
   return camera;
 }
 
+CameraParams frame_params_of(const ApplyOptions& o, const ExrInput& color, std::string* text);
+
 // The camera constants of one frame: orthographic with --ortho-size, else perspective (finite or
-// infinite far). *text describes it for --verbose.
+// infinite far). *text describes it for --verbose. The library's rules on what the flags and the
+// file make together (a frustum beyond float's range) name both.
 CameraParams frame_params(const ApplyOptions& o, const ExrInput& color, std::string* text) {
+  try {
+    const CameraParams params = frame_params_of(o, color, text);
+    validate(params);  // here, where the flags and the file can be named, rather than in the pass
+    return params;
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    if (what.rfind("--", 0) == 0 || what.rfind(color.path, 0) == 0) throw;  // already names its flag or file
+    throw Error(color.path + ": the camera of " + (o.camera_flags.empty() ? "the file" : o.camera_flags) +
+                " and this frame: " + what);
+  }
+}
+
+CameraParams frame_params_of(const ApplyOptions& o, const ExrInput& color, std::string* text) {
   char buf[256];
   const char* z = o.infinite_far ? "reversed Z (implied by --infinite-far)" : o.reversed_z ? "reversed Z" : "conventional Z";
   if (o.ortho_size > 0.0f) {
@@ -515,8 +531,6 @@ int run_apply(const ApplyOptions& o) {
   if (o.pixel_type != "float" && o.pixel_type != "half")
     throw Error("--pixel-type must be half or float (got '" + o.pixel_type + "')");
   if (!o.compression.empty()) parse_exr_compression(o.compression);
-  if (o.threads < 0 || o.threads > 4096)
-    throw Error("--threads must be between 1 and 4096 (got " + std::to_string(o.threads) + ")");
   const FramePattern color = parse_frame_pattern(o.color_path);
   const FramePattern depth = parse_frame_pattern(o.depth_path);
   const FramePattern out = parse_frame_pattern(o.out_path);
@@ -534,9 +548,9 @@ int run_apply(const ApplyOptions& o) {
         throw Error("'" + p->text + "' has a frame placeholder but --color '" + o.color_path + "' has none");
     if (!o.frames.empty()) throw Error("--frames needs a frame placeholder in --color (e.g. shot.####.exr)");
     FrameJob job;
-    job.paths = {o.color_path, o.depth_path, o.out_path, o.png_path};
+    job.paths = {frame_path(color, 0), frame_path(depth, 0), frame_path(out, 0), frame_path(png, 0)};  // '%%' is '%'
     check_frame_files(o, job.paths);  // before anything is read or written
-    const int swept = detail::remove_stale_temporaries_of({o.out_path, o.png_path});
+    const int swept = detail::remove_stale_temporaries_of({job.paths.out, job.paths.png});
     if (o.verbose && swept > 0) std::fprintf(stderr, "removed %d stale temporary file(s) of killed runs\n", swept);
     set_memory_stage("fogging the frame");
     const std::string hint = frame_memory_hint(memory);
@@ -575,7 +589,7 @@ int run_apply(const ApplyOptions& o) {
                  frames.size());
 
   // The files every frame reads (each frame's own are checked as it is read).
-  check_files({{"--depth", depth.is_sequence ? "" : o.depth_path}, {"--volumes", o.volumes.volumes_path},
+  check_files({{"--depth", depth.is_sequence ? "" : frame_path(depth, 0)}, {"--volumes", o.volumes.volumes_path},
                {"--shadow-map", o.volumes.shadow_map_path}},
               {});
   check_sequence_outputs(o, color, depth, out, png, frames);

@@ -9,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/cli.h"
+#include "cli/flag_values.h"
 #include "cli/number_list.h"
 #include "cli/volumes_cli.h"
 #include "runtime/format.h"
@@ -37,6 +38,10 @@ bool has(const std::vector<std::string>& given, const std::string& flag) {
 std::array<double, 16> parse_sixteen(const std::string& text) {
   const std::vector<double> numbers =
       parse_numbers("--camera-to-world", text, 16, "16 comma-separated numbers m00,m01,...,m33, row by row");
+  for (std::size_t i = 0; i < numbers.size(); ++i)
+    if (!(std::isfinite(numbers[i]) && std::fabs(numbers[i]) <= 3.4028234663852886e38))
+      throw Error("--camera-to-world element " + std::to_string(i) + " must be finite in float, |x| <= 3.4e38 (got '" +
+                  text + "')");
   std::array<double, 16> v{};
   std::copy(numbers.begin(), numbers.end(), v.begin());
   return v;
@@ -50,24 +55,30 @@ void add_camera_options(CLI::App& app, CameraCliOptions& o) {
                  "The camera's camera-to-world matrix as the renderer prints it: 16 numbers m00,m01,...,m33 row by "
                  "row (unity, blender: column vectors, translation in the last column; houdini, maya: row vectors, "
                  "translation in the last row); rigid (no scale); needs --axes; not with --eye/--forward/--up")
+      ->check(value_check([](const std::string& text) { parse_sixteen(text); }))
       ->group(group);
   app.add_option("--axes", o.axes,
                  "The renderer's world of every world-space input (--camera-to-world, --eye/--forward/--up, "
                  "--light-dir, --light-view-proj, the volumes, the file's worldToCamera): unity (left-handed, +y up; "
                  "fogcl's own, the default), blender (right-handed, +z up), houdini or maya (right-handed, +y up)")
+      ->check(keyword_check("--axes", {"unity", "blender", "houdini", "maya"}))
       ->group(group);
   app.add_option("--focal-length", o.focal_length,
                  "Lens focal length [mm], > 0: with --sensor-width, the vertical fov by Blender's sensor-fit rules; "
                  "not with --fov or --ortho-size")
+      ->check(real_check("--focal-length", kPositive))
       ->group(group);
   app.add_option("--sensor-width", o.sensor_width, "Sensor width [mm], > 0 (Blender's default 36); needs --focal-length")
+      ->check(real_check("--sensor-width", kPositive))
       ->group(group);
   app.add_option("--sensor-height", o.sensor_height,
                  "Sensor height [mm], > 0; read only with --sensor-fit vertical (as Blender)")
+      ->check(real_check("--sensor-height", kPositive))
       ->group(group);
   app.add_option("--sensor-fit", o.sensor_fit,
                  "auto (the sensor width spans the larger image dimension), horizontal (the width spans the image "
                  "width) or vertical (the sensor height spans the image height)")
+      ->check(keyword_check("--sensor-fit", {"auto", "horizontal", "vertical"}))
       ->capture_default_str()
       ->group(group);
 }

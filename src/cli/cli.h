@@ -35,6 +35,10 @@ class Backend {
   std::unique_ptr<FogPass> pass_;
 };
 
+// "--device: " when `choice` (the flag's value) is set, "FOGCL_DEVICE: " when that variable chose
+// the device, else "": the prefix of a message about the device chosen.
+std::string device_choice_source(const std::string& choice);
+
 struct DemoOptions {
   std::string out_dir = "fogcl-demo";
   int width = 1280;
@@ -67,6 +71,7 @@ struct ApplyOptions {
   bool max_error_given = false;    // --max-error E picks the precision variant
   double max_error = 0;            // E, >= 0
   FogSettings settings;
+  std::string camera_flags;        // the camera flags as typed ("--near 0.3, --far 1000"), for messages
   std::string device;
   bool verbose = false;
   VolumeCliOptions volumes;        // --volumes and its flags (cli/volumes_cli.h)

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <vector>
 
@@ -87,18 +88,23 @@ int run_demo(const DemoOptions& o) {
   // Before anything is allocated (or the folder made): a 16384x16384 scene needs about 90 GiB.
   check_demo_memory(o.width, o.height, memory_limit(o.max_memory));
   set_memory_stage("rendering and fogging the demo scene");
-  fs::create_directories(o.out_dir);
   const auto path = [&](const std::string& name) { return (fs::path(o.out_dir) / name).string(); };
 
   std::vector<std::unique_ptr<Backend>> backends;
   if (resolve_device_choice(o.device) != "scalar") {
+    // Without a choice (no --device, no FOGCL_DEVICE) a machine without OpenCL still runs the
+    // demo on the scalar path; a device asked for that cannot be had is an error, as in apply.
+    const char* env = std::getenv("FOGCL_DEVICE");
+    const bool chosen = !o.device.empty() || (env != nullptr && *env != '\0');
     try {
       backends.push_back(std::make_unique<Backend>(o.device));
     } catch (const Error& e) {
+      if (chosen) throw;
       std::fprintf(stderr, "fogcl demo: no OpenCL path (%s); running the scalar path only\n", e.what());
     }
   }
   backends.push_back(std::make_unique<Backend>("scalar"));
+  fs::create_directories(o.out_dir);  // once the device is there: a failed run leaves nothing
 
   std::printf("scene: %dx%d, %zu settings\n", o.width, o.height, demo_settings().size());
   for (const auto& b : backends) std::printf("path: %s\n", b->name().c_str());

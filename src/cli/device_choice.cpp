@@ -76,15 +76,21 @@ std::string pocl_cache_problem() {
 
 }  // namespace
 
+std::string device_choice_source(const std::string& choice) {
+  if (!choice.empty()) return "--device: ";
+  const char* env = std::getenv("FOGCL_DEVICE");
+  return env != nullptr && *env != '\0' ? "FOGCL_DEVICE: " : "";
+}
+
 Backend::Backend(const std::string& choice) {
   const std::string resolved = resolve_device_choice(choice);
   if (resolved == "scalar") return;
   try {
     runtime_ = std::make_unique<Runtime>(resolved);
-  } catch (const Error&) {
+  } catch (const Error& e) {
     // A PoCL that could not start offers no device: say why instead of "available: none".
     if (const std::string problem = pocl_cache_problem(); !problem.empty()) throw Error(problem);
-    throw;
+    throw Error(device_choice_source(choice) + e.what());
   }
   // Its builds would fail one by one, each with a build log that does not say why.
   if (device_is_pocl_cpu(runtime_->device()))

@@ -9,6 +9,7 @@
 
 #include "camera/camera_basis.h"
 #include "cli/cli.h"
+#include "cli/flag_values.h"
 #include "cli/number_list.h"
 #include "cli/usage.h"
 #include "fogcl/renderer_camera.h"
@@ -23,14 +24,8 @@ const char* const kHeightFlags[] = {"--extinction", "--inscattering", "--height-
 
 using detail::str;
 
-// One number (nan and inf read as such, for the rules to name them).
-double parse_number(const std::string& flag, const std::string& text) {
-  char* end = nullptr;
-  const double d = std::strtod(text.c_str(), &end);
-  if (text.empty() || end == text.c_str() || *end != '\0')
-    throw Error(flag + " must be a number (got '" + text + "')");
-  return d;
-}
+// One number (nan and inf read as such, for the rules to name them); malformed text is a usage error.
+double parse_number(const std::string& flag, const std::string& text) { return read_number(flag, text); }
 
 glm::vec3 non_negative_rgb(const std::string& flag, const std::string& text) {
   const glm::dvec3 c = parse_triple(flag, text, "R,G,B");
@@ -43,22 +38,39 @@ glm::vec3 non_negative_rgb(const std::string& flag, const std::string& text) {
 }  // namespace
 
 void add_height_options(CLI::App& app, HeightCliOptions& o) {
+  const auto rgb = [](const char* flag) {
+    return value_check([flag](const std::string& text) { non_negative_rgb(flag, text); });
+  };
   const char* group = "Height and atmospheric fog (--mode height; docs/DESIGN.md §6)";
   app.add_option("--extinction", o.extinction,
-                 "Extinction R,G,B [1/world unit], >= 0 (instead of --density, which sets all three)")->group(group);
+                 "Extinction R,G,B [1/world unit], >= 0 (instead of --density, which sets all three)")
+      ->check(rgb("--extinction"))
+      ->group(group);
   app.add_option("--inscattering", o.inscattering, "In-scattering R,G,B [1/world unit], >= 0 (default: the extinction)")
+      ->check(rgb("--inscattering"))
       ->group(group);
   app.add_option("--height-falloff", o.falloff,
                  "Height falloff k [1/world unit], finite: > 0 thins upward, < 0 thickens, 0 homogeneous (default 0)")
+      ->check(real_check("--height-falloff", kFinite))
       ->group(group);
-  app.add_option("--base-height", o.base_height, "World y where the coefficients hold (default 0)")->group(group);
-  app.add_option("--cutoff", o.cutoff, "No fog beyond this distance along the ray [world units], > --start (default: none)")
+  app.add_option("--base-height", o.base_height, "World y where the coefficients hold, finite (default 0)")
+      ->check(real_check("--base-height", kFinite))
       ->group(group);
-  app.add_option("--max-opacity", o.max_opacity, "Maximum fog opacity in [0, 1] (default 1)")->group(group);
+  app.add_option("--cutoff", o.cutoff, "No fog beyond this distance along the ray [world units], finite and > --start (default: none)")
+      ->check(real_check("--cutoff", kFinite))
+      ->group(group);
+  app.add_option("--max-opacity", o.max_opacity, "Maximum fog opacity in [0, 1] (default 1)")
+      ->check(real_check("--max-opacity", RealRule{"in [0, 1]", 0.0, false, 1.0, false}))
+      ->group(group);
   app.add_option("--sun-color", o.sun_color,
-                 "Sun in-scattering lobe color R,G,B >= 0 toward --light-dir (default: no lobe)")->group(group);
-  app.add_option("--sun-exponent", o.sun_exponent, "Sun lobe exponent, > 0 (default 8; larger is tighter)")->group(group);
+                 "Sun in-scattering lobe color R,G,B >= 0 toward --light-dir (default: no lobe)")
+      ->check(rgb("--sun-color"))
+      ->group(group);
+  app.add_option("--sun-exponent", o.sun_exponent, "Sun lobe exponent, > 0 (default 8; larger is tighter)")
+      ->check(real_check("--sun-exponent", kPositive))
+      ->group(group);
   app.add_option("--sun-start", o.sun_start, "Sun lobe start distance along the ray [world units], >= 0 (default 0)")
+      ->check(real_check("--sun-start", kNonNegative))
       ->group(group);
 }
 
@@ -99,7 +111,7 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
     if (given("--density")) throw Error("give either --density or --extinction, not both");
     h.extinction = non_negative_rgb("--extinction", o.extinction);
   } else if (!(std::isfinite(ap.settings.density) && ap.settings.density >= 0.0f)) {
-    throw Error("--density must be finite and >= 0 (got " + str(ap.settings.density) + ")");
+    throw Error("--density must be finite and >= 0 (got " + flag_value(app, "--density") + ")");
   }
   if (given("--inscattering")) h.inscattering = non_negative_rgb("--inscattering", o.inscattering);
   if (given("--height-falloff")) {
@@ -114,12 +126,14 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
   }
   if (given("--start")) {
     if (!(std::isfinite(ap.settings.start) && ap.settings.start >= 0.0f))
-      throw Error("--start must be finite and >= 0 with --mode height (got " + str(ap.settings.start) + ")");
+      throw Error("--start must be finite and >= 0 with --mode height (got " + flag_value(app, "--start") + ")");
     h.start = ap.settings.start;
   }
   if (given("--cutoff")) {
     const double c = parse_number("--cutoff", o.cutoff);
-    if (!(c > double(h.start))) throw Error("--cutoff must be > --start (got --cutoff " + o.cutoff + ", --start " + str(h.start) + ")");
+    if (!(c > double(h.start)))
+      throw Error("--cutoff must be > --start (got --cutoff " + o.cutoff + ", --start " +
+                  (given("--start") ? flag_value(app, "--start") : str(h.start)) + ")");
     h.cutoff = float(c);
   }
   if (given("--max-opacity")) {

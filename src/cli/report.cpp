@@ -17,10 +17,14 @@ namespace fogcl::cli {
 
 int run_report(const ReportCliOptions& o) {
   namespace fs = std::filesystem;
-  fs::create_directories(o.out_dir);
   std::unique_ptr<Runtime> runtime;
   const std::string resolved = resolve_device_choice(o.device);
-  if (resolved != "scalar") runtime = std::make_unique<Runtime>(resolved);
+  try {
+    if (resolved != "scalar") runtime = std::make_unique<Runtime>(resolved);
+  } catch (const Error& e) {
+    throw Error(device_choice_source(o.device) + e.what());
+  }
+  fs::create_directories(o.out_dir);  // once the device is there: a failed run leaves nothing
 
   ReportOptions options;
   options.width = o.width;
@@ -54,7 +58,6 @@ int run_report(const ReportCliOptions& o) {
 
 int run_volume_report_cli(const ReportCliOptions& o) {
   namespace fs = std::filesystem;
-  fs::create_directories(o.out_dir);
   VolumeReportOptions options;
   options.width = o.width;
   options.height = o.height;
@@ -76,7 +79,15 @@ int run_volume_report_cli(const ReportCliOptions& o) {
   const std::string resolved = resolve_device_choice(o.device);
   if (resolved == "scalar")
     throw Error("fogcl report --volumetric measures OpenCL kernel variants; the scalar path (--device scalar) has none");
-  const Runtime runtime(resolved);
+  const std::unique_ptr<Runtime> opened = [&] {
+    try {
+      return std::make_unique<Runtime>(resolved);
+    } catch (const Error& e) {
+      throw Error(device_choice_source(o.device) + e.what());
+    }
+  }();
+  const Runtime& runtime = *opened;
+  fs::create_directories(o.out_dir);  // once the device is there: a failed run leaves nothing
   std::size_t last_pct = 0;
   options.progress = [&](std::size_t done, std::size_t total) {
     const std::size_t pct = 100 * done / total;

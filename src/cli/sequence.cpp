@@ -16,6 +16,22 @@ namespace {
 
 bool is_digit(char c) { return c >= '0' && c <= '9'; }
 
+// printf's escape: each "%%" from `from` on (the file name) names one '%' (the placeholder scan has
+// checked that no other '%' is there).
+std::string unescape_percent(const std::string& s, std::size_t from) {
+  std::string out = s.substr(0, std::min(from, s.size()));
+  for (std::size_t i = out.size(); i < s.size(); ++i) {
+    out += s[i];
+    if (s[i] == '%' && i + 1 < s.size() && s[i + 1] == '%') ++i;
+  }
+  return out;
+}
+
+std::size_t file_name_start(const std::string& path) {
+  const std::size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? 0 : slash + 1;
+}
+
 }  // namespace
 
 FramePattern parse_frame_pattern(const std::string& path) {
@@ -54,13 +70,13 @@ FramePattern parse_frame_pattern(const std::string& path) {
   if (count == 0) return p;
   p.is_sequence = true;
   p.width = width;
-  p.prefix = path.substr(0, found_at);
-  p.suffix = path.substr(found_at + found_len);
+  p.prefix = unescape_percent(path.substr(0, found_at), name_start);
+  p.suffix = unescape_percent(path.substr(found_at + found_len), 0);
   return p;
 }
 
 std::string frame_path(const FramePattern& p, int frame) {
-  if (!p.is_sequence) return p.text;
+  if (!p.is_sequence) return unescape_percent(p.text, file_name_start(p.text));
   std::string digits = std::to_string(frame);
   if (int(digits.size()) < p.width) digits.insert(0, std::size_t(p.width) - digits.size(), '0');
   return p.prefix + digits + p.suffix;

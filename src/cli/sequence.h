@@ -19,7 +19,9 @@ struct FramePattern {
 
 // Throws fogcl::Error for two placeholders or an unsupported printf conversion ("%5d", "%s").
 FramePattern parse_frame_pattern(const std::string& path);
-// The path of `frame` (>= 0); the pattern's text itself when it is not a sequence.
+// The path of `frame` (>= 0); the pattern's text itself when it is not a sequence. In both, "%%"
+// is a literal '%' (printf's escape; folders keep theirs: placeholders are only looked for in the
+// file name, so is the escape).
 std::string frame_path(const FramePattern& pattern, int frame);
 // Frames whose files exist, ascending (a name counts when frame_path() gives it back exactly).
 // A folder that does not exist has none; one that cannot be listed throws fogcl::Error.

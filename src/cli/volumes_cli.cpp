@@ -18,6 +18,7 @@
 #include <CLI/CLI.hpp>
 
 #include "cli/camera_cli.h"
+#include "cli/flag_values.h"
 #include "cli/frame_memory.h"
 #include "cli/number_list.h"
 #include "cli/usage.h"
@@ -62,6 +63,13 @@ const char* const kVolumeFlags[] = {"--eye",
                                     "--light-view-proj",
                                     "--shadow-reversed-z"};
 
+glm::vec3 light_color_value(const std::string& text) {
+  const glm::vec3 c = parse_finite_vec3("--light-color", text);
+  for (int k = 0; k < 3; ++k)
+    if (c[k] < 0.0f) throw Error("--light-color must be >= 0 in each channel (got '" + text + "')");
+  return c;
+}
+
 bool given(const VolumeCliOptions& o, const std::string& flag) {
   return std::find(o.given.begin(), o.given.end(), flag) != o.given.end();
 }
@@ -73,27 +81,40 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
   app.add_option("--volumes", o.volumes_path,
                  "VOLUMES.json: {\"volumes\": [{\"center\": [x,y,z], \"radius\": r, ...}]} (docs/cli.md#volumesjson); "
                  "--mode may then be left out (off: only the volumes)")
+      ->check(text_check("--volumes", "the VOLUMES.json file"))
       ->group(group);
   const std::string pose = " (--volumes needs the pose: these three, or --camera-to-world, or none of them to read "
                            "the color file's worldToCamera)";
-  app.add_option("--eye", o.eye, "Camera position X,Y,Z [world units]" + pose)->group(group);
-  app.add_option("--forward", o.forward, "Camera view direction X,Y,Z, non-zero" + pose)->group(group);
-  app.add_option("--up", o.up, "Camera up X,Y,Z, not parallel to --forward" + pose)->group(group);
+  const auto direction = [](const char* flag) {
+    return value_check([flag](const std::string& text) { parse_direction(flag, text); });
+  };
+  app.add_option("--eye", o.eye, "Camera position X,Y,Z [world units]" + pose)
+      ->check(value_check([](const std::string& text) { parse_finite_vec3("--eye", text); }))
+      ->group(group);
+  app.add_option("--forward", o.forward, "Camera view direction X,Y,Z, non-zero" + pose)
+      ->check(direction("--forward"))
+      ->group(group);
+  app.add_option("--up", o.up, "Camera up X,Y,Z, not parallel to --forward" + pose)->check(direction("--up"))->group(group);
   app.add_option("--light-dir", o.light_dir, "Main light direction X,Y,Z, from the scene toward the light")
+      ->check(direction("--light-dir"))
       ->capture_default_str()
       ->group(group);
   app.add_option("--light-color", o.light_color, "Main light color, linear R,G,B >= 0")
+      ->check(value_check([](const std::string& text) { light_color_value(text); }))
       ->capture_default_str()
       ->group(group);
-  app.add_option("--time", o.time, "Noise scroll time [s] (default 0; sequences: frame number / --fps)")->group(group);
+  app.add_option("--time", o.time, "Noise scroll time [s], finite (default 0; sequences: frame number / --fps)")
+      ->check(real_check("--time", kFinite))
+      ->group(group);
   app.add_option("--frame", o.frame, "Jitter frame index >= 0 (default 0; sequences: the frame number)")
       ->check(integer_in(0, 4294967295LL, "in [0, 4294967295]"))
       ->group(group);
   app.add_option("--fps", o.fps, "Sequences: frames per second for the default --time, > 0")
+      ->check(real_check("--fps", kPositive))
       ->capture_default_str()
       ->group(group);
   app.add_option("--integrator", o.integrator, "stylized (the seed's look) or physical (energy-conserving)")
-      ->transform(CLI::IsMember(kIntegrators, CLI::ignore_case))
+      ->check(keyword_check("--integrator", {"stylized", "physical"}))
       ->capture_default_str()
       ->group(group);
   app.add_option("--steps", o.steps, "March steps per ray, in [1, 4096]")
@@ -101,15 +122,15 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
       ->capture_default_str()
       ->group(group);
   app.add_option("--volume-resolution", o.resolution, "March target: full, half or quarter resolution")
-      ->transform(CLI::IsMember(kResolutions, CLI::ignore_case))
+      ->check(keyword_check("--volume-resolution", {"full", "half", "quarter"}))
       ->capture_default_str()
       ->group(group);
   app.add_option("--upsample", o.upsample, "depth-aware (no fog bleeding across silhouettes) or bilinear")
-      ->transform(CLI::IsMember(kUpsamplings, CLI::ignore_case))
+      ->check(keyword_check("--upsample", {"depth-aware", "bilinear"}))
       ->capture_default_str()
       ->group(group);
   app.add_option("--noise-size", o.noise_size, "Noise texels per side: 32, 64 or 128")
-      ->check(integer_in(32, 128, "32, 64 or 128"))
+      ->check(integer_in(32, 128, "32, 64 or 128", {32, 64, 128}))
       ->capture_default_str()
       ->group(group);
   app.add_option("--noise-seed", o.noise_seed, "Noise seed, in [0, 4294967295]")
@@ -119,16 +140,18 @@ void add_volume_options(CLI::App& app, VolumeCliOptions& o) {
   app.add_option("--noise-sampling", o.noise_sampling,
                  "auto (image on GPUs and accelerators with 3D images, else buffer), buffer (trilinear in the "
                  "kernel) or image (OpenCL 3D image, hardware filtering on GPUs)")
-      ->transform(CLI::IsMember(kSamplings, CLI::ignore_case))
+      ->check(keyword_check("--noise-sampling", {"auto", "buffer", "image"}))
       ->capture_default_str()
       ->group(group);
   app.add_option("--shadow-map", o.shadow_map_path,
                  "Main light's shadow map: EXR with the light's raw depth in channel Z (or its only channel); "
                  "needs --light-view-proj")
+      ->check(text_check("--shadow-map", "the shadow map EXR"))
       ->group(group);
   app.add_option("--light-view-proj", o.light_view_proj,
                  "World -> light clip matrix, 16 numbers m00,m01,...,m33 row-major (the first four are the first "
                  "row); clip xy in [-1, 1] map to the shadow map's uv, clip z / w is its depth")
+      ->check(value_check([](const std::string& text) { parse_light_view_proj(text); }))
       ->group(group);
   app.add_flag("--shadow-reversed-z", o.shadow_reversed_z,
                "The shadow map holds reversed Z (1 at the light's near plane)")
@@ -211,10 +234,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     s.pose_from_ = std::string("--eye/--forward/--up") + (o.axes ? std::string(", --axes ") + to_string(axes) : "");
   }
   s.light_.direction = parse_direction("--light-dir", o.light_dir);
-  s.light_.color = parse_finite_vec3("--light-color", o.light_color);
-  for (int k = 0; k < 3; ++k)
-    if (s.light_.color[k] < 0.0f)
-      throw Error("--light-color must be >= 0 in each channel (got '" + o.light_color + "')");
+  s.light_.color = light_color_value(o.light_color);
   s.light_.direction = to_fogcl * s.light_.direction;
 
   if (!std::isfinite(o.time)) throw Error("--time must be finite (got " + str(o.time) + ")");
@@ -342,10 +362,16 @@ void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImag
     }
     budget_why_ += "volumes: " + c.reason + "\n";
   }
-  if (pass_)
-    pass_->apply(in, depth, out, camera, scene, settings_, shadow());
-  else
-    apply_volumes_scalar(in, depth, out, camera, scene, settings_, shadow());
+  try {
+    if (pass_)
+      pass_->apply(in, depth, out, camera, scene, settings_, shadow());
+    else
+      apply_volumes_scalar(in, depth, out, camera, scene, settings_, shadow());
+  } catch (const ClError&) {
+    throw;  // the device's
+  } catch (const Error& e) {
+    throw Error(options_.volumes_path + ": " + e.what());  // what the volumes make in this frame (how many are visible)
+  }
   if (!verbose) return;
   std::fprintf(stderr, "%s", budget_why_.c_str());
   const std::size_t visible = visible_volumes(scene, camera, max_eye_depth(depth, camera)).size();

@@ -378,8 +378,12 @@ void write_file_atomically(const std::string& path, const char* kind,
 std::string destination_problem(const std::string& path) {
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0 && S_ISLNK(st.st_mode) && ::stat(path.c_str(), &st) != 0) {
+    const int err = errno;
     std::error_code ec;
     const std::string to = std::filesystem::read_symlink(path, ec).string();
+    if (err == ELOOP)
+      return "it is a symbolic link to '" + to + "' in a loop of symbolic links (" + error_text(err) + ")";
+    if (err != ENOENT) return "it is a symbolic link to '" + to + "', which cannot be followed (" + error_text(err) + ")";
     return "it is a symbolic link to '" + to + "', which does not exist";
   }
   if (::stat(path.c_str(), &st) == 0)

@@ -114,9 +114,15 @@ void validate(const ShadowMapParams& s) {
       scale = std::fmax(scale, std::fabs(double(m[c][r])));
     }
   const double det = glm::determinant(glm::dmat4(m));
-  if (scale == 0.0 || !(std::fabs(det) > 1e-12 * std::pow(scale, 4)))
-    throw Error("light view-projection matrix is singular (determinant " + str(det) +
-                "): it must map world space one-to-one to light clip space");
+  // Relative to the elements' scale: a determinant that is tiny against it is singular in float.
+  const double bound = 1e-12 * std::pow(scale, 4);
+  if (det == 0.0)
+    throw Error("light view-projection matrix is singular (determinant 0): it must map world space one-to-one to "
+                "light clip space");
+  if (!(std::fabs(det) > bound))
+    throw Error("light view-projection matrix is ill-conditioned: |determinant| " + str(std::fabs(det)) +
+                " must be > 1e-12 x (largest |element| " + str(scale) + ")^4 = " + str(bound) +
+                ", for it to map world space one-to-one to light clip space");
   if (!(std::isfinite(s.bias) && s.bias >= 0.0f))
     throw Error("shadow bias must be finite and >= 0 (got " + str(s.bias) + ")");
 }
