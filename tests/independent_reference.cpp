@@ -228,4 +228,70 @@ Reference height_fog(const ColorImage& color, const DepthImage& depth, const Cam
   return r;
 }
 
+VolumeReference stylized_volumes(const ColorImage& color, const DepthImage& depth, const CameraParams& cam,
+                                 const VolumeScene& scene, const VolumeSettings& settings) {
+  VolumeReference out;
+  Reference& r = out.frame;
+  r.width = color.width();
+  r.height = color.height();
+  r.rgb.resize(3 * color.pixel_count());
+  r.factor.resize(color.pixel_count());
+  out.certain.assign(color.pixel_count(), 1);
+  const Vec fwd = normalized(vec(scene.pose.forward));
+  const Vec right = normalized(cross(vec(scene.pose.up), fwd));
+  const Vec up = cross(fwd, right);
+  const Vec eye = vec(scene.pose.eye);
+  const Vec light = normalized(vec(scene.light.direction));
+  const double n = cam.near_plane(), f = cam.far_plane();
+  // The march with adaptive steps skips its first sample and marches the rest at 0.2 steps after
+  // going back 4 of them: accumulated / marched = (steps - 1) / steps.
+  const double ratio = settings.adaptive_steps ? double(settings.steps - 1) / settings.steps : 1.0;
+  for (int y = 0; y < r.height; ++y)
+    for (int x = 0; x < r.width; ++x) {
+      const std::size_t i = std::size_t(y) * r.width + x;
+      const Vec c = pixel_ray(cam, x, y, r.width, r.height);
+      const Vec world = {right[0] * c[0] + up[0] * c[1] + fwd[0] * c[2], right[1] * c[0] + up[1] * c[1] + fwd[1] * c[2],
+                         right[2] * c[0] + up[2] * c[1] + fwd[2] * c[2]};
+      const Vec dir = normalized(world);
+      // The ray starts on the near plane: eye + R c near / c.z.
+      const double to_near = n / c[2] * std::sqrt(dot(world, world));
+      const Vec origin = {eye[0] + dir[0] * to_near, eye[1] + dir[1] * to_near, eye[2] + dir[2] * to_near};
+      const Depth dep = read_depth(depth.at(x, y), cam);
+      const double t_scene = dep.sky ? INFINITY : (dep.linear01 * f - n) * std::sqrt(dot(c, c)) / c[2];
+      double P[3] = {0, 0, 0}, A = 0;
+      for (const FogVolume& v : scene.volumes) {
+        // |origin + t dir - center|^2 = r^2: t = tc -+ sqrt(r^2 - d^2), d the ray's distance to the centre.
+        const Vec oc = {vec(v.center)[0] - origin[0], vec(v.center)[1] - origin[1], vec(v.center)[2] - origin[2]};
+        const double tc = dot(oc, dir), d2 = dot(oc, oc) - tc * tc, r2 = double(v.radius) * v.radius;
+        if (std::fabs(std::sqrt(std::max(d2, 0.0)) - v.radius) < 1e-4 * v.radius) out.certain[i] = 0;
+        if (d2 >= r2) continue;
+        const double half = std::sqrt(r2 - d2);
+        const double front = std::max(tc - half, 0.0), back = tc + half;
+        if (std::fabs(front - t_scene) < 1e-4 * std::max(1.0, t_scene) || std::fabs(back) < 1e-4 * v.radius)
+          out.certain[i] = 0;
+        if (!(back > 0) || !(front < t_scene)) continue;
+        const double reach = std::min((t_scene - front) * v.occluder_overshoot, back - front);
+        if (!(reach > 0)) continue;
+        const double k = std::pow(clamp01(dot(dir, light)), double(v.directional_falloff));
+        double rgb[3];
+        for (int ch = 0; ch < 3; ++ch) {
+          const double L = scene.light.color[ch];
+          const double base = 1 + (L - 1) * v.light_contribution, lobe = 1 + (L - 1) * v.directional_light_contribution;
+          const double light_color = base + (lobe - base) * k;
+          const double fog = v.fog_color[ch] + (double(v.directional_fog_color[ch]) - v.fog_color[ch]) * k;
+          rgb[ch] = fog * std::max(light_color, 0.1 * light_color);
+        }
+        const double fog_a = v.fog_color.a + (double(v.directional_fog_color.a) - v.fog_color.a) * k;
+        const double a = fog_a * clamp01(clamp01(ratio) * v.density);
+        // The seed's blend: SrcAlpha, OneMinusSrcAlpha (color); One, OneMinusSrcAlpha (alpha).
+        for (int ch = 0; ch < 3; ++ch) P[ch] = rgb[ch] * a + P[ch] * (1 - a);
+        A = a + A * (1 - a);
+      }
+      const glm::vec4 in = color.pixel(x, y);
+      for (int ch = 0; ch < 3; ++ch) r.rgb[3 * i + ch] = A == 0 ? double(in[ch]) : P[ch] + in[ch] * (1 - A);
+      r.factor[i] = 1 - A;
+    }
+  return out;
+}
+
 }  // namespace fogcl::test::independent

@@ -11,6 +11,7 @@
 #include "fogcl/camera.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
+#include "fogcl/volumes.h"
 
 namespace fogcl::test::independent {
 
@@ -34,6 +35,20 @@ Reference deferred_fog(const ColorImage& color, const DepthImage& depth, const C
 // settings.mode must be FogMode::height and camera.pose set.
 Reference height_fog(const ColorImage& color, const DepthImage& depth, const CameraParams& camera,
                      const FogSettings& settings);
+
+// docs/volumetric.md's stylized integrator on spheres of constant density (noise off, no fades, no
+// shadow map, no jitter) at full resolution, composited: the march then accumulates exactly what
+// it marches (adaptive stepping: all but the first, skipped, sample), so each volume's alpha is
+// fog_color.a·saturate(density·accumulated/marched) and its color the lobe's, and the volumes
+// are drawn in order with the seed's blend and composited as P + color·(1 - A). `certain` is 0
+// where the definition is discontinuous within 1e-4 of the pixel's ray (a grazing ray, an occluder
+// at a sphere's front), where float rounding may take either side. Perspective raw depth.
+struct VolumeReference {
+  Reference frame;
+  std::vector<char> certain;  // per pixel
+};
+VolumeReference stylized_volumes(const ColorImage& color, const DepthImage& depth, const CameraParams& camera,
+                                 const VolumeScene& scene, const VolumeSettings& settings);
 
 // ∫[a, b] g(s) ds by 8-point Gauss-Legendre quadrature on `panels` equal panels, in long double
 // (nodes from Newton's iteration on P_8).
