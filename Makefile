@@ -15,8 +15,11 @@ build: setup
 demo: build
 	$(BUILD)/src/fogcl demo --out out/demo
 
+# Ends with the count of tests that passed, failed and were skipped (with each skip's reason),
+# from ctest's JUnit file; the exit status is ctest's.
 test: build
-	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) --output-junit junit.xml; \
+	  status=$$?; python3 scripts/test_summary.py $(BUILD)/junit.xml; exit $$status
 
 # Google Benchmark suite -> out/bench/{fog,pocl1,start-*}.json, table.md and throughput.png.
 bench: build
