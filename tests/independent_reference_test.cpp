@@ -126,15 +126,15 @@ Scene deferred_scene(std::uint32_t seed) {
   const CameraParams cam = sc.camera;
   fill_frame(sc, rng);
   if (step) {
-    // Pixels within 1e-3 of the step (their distance from the reference's e^-d) move to the near
-    // plane, well before it.
+    // Pixels within 1e-3 of the step (the reference's d, read back from e^(-d / 1000)) move to the
+    // near plane, before it.
     const independent::Reference d = independent::deferred_fog(sc.color, sc.depth, cam, probe);
     for (int y = 0; y < kHeight; ++y)
       for (int x = 0; x < kWidth; ++x) {
         const double f = d.factor[std::size_t(y) * kWidth + x];
         const double dist = f > 0 ? -1000 * std::log(f) : INFINITY;
         if (std::fabs(dist - s.start) < 1e-3 * std::max(double(s.start), 1.0))
-          sc.depth.at(x, y) = cam.reversed_z ? 1.0f : 0.0f;  // the near plane: d = 0 (depth) or |ray| near / far
+          sc.depth.at(x, y) = cam.reversed_z ? 1.0f : 0.0f;  // d = 0 depth-based, about near distance-based
       }
   }
   return sc;
