@@ -15,8 +15,11 @@ build: setup
 demo: build
 	$(BUILD)/src/fogcl demo --out out/demo
 
+# Ends with the count of tests that passed, failed and were skipped (with each skip's reason),
+# from ctest's JUnit file; the exit status is ctest's.
 test: build
-	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) --output-junit junit.xml; \
+	  status=$$?; python3 scripts/test_summary.py $(BUILD)/junit.xml; exit $$status
 
 # Google Benchmark suite -> out/bench/{fog,pocl1,start-*}.json, table.md and throughput.png.
 bench: build
@@ -46,10 +49,11 @@ asan-build:
 	  -DFOGCL_BUILD_BENCH=OFF -DFOGCL_BUILD_FUZZ=ON
 	cmake --build $(ASAN_BUILD) -j $(JOBS)
 
-# Every test but the 1080p / 8K frame sizes: under ASan they run the same host code as the smaller
-# sizes (the kernel itself runs in PoCL's JIT, which ASan does not instrument) at 3x the time.
+# Every test but the 1080p / 8K frame sizes, which under ASan run the same host code as the smaller
+# sizes (the kernel itself runs in PoCL's JIT, which ASan does not instrument) at 3x the time, and
+# the mutation check, which builds an unsanitized copy of its own (`make test` runs it).
 asan-test: asan-build
-	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -E '1920x1080|EightK|VolumeSizeSweep'
+	ctest --test-dir $(ASAN_BUILD) --output-on-failure -j $(JOBS) -E '1920x1080|EightK|VolumeSizeSweep|MutationCheck'
 
 # Bounded fuzz runs (FUZZ_SECONDS each) from the generated seed corpora: EXR loading, then the
 # VOLUMES.json parser (seeded with the demo's volume files); new inputs go to

@@ -106,6 +106,31 @@ TEST_F(CliHeight, EveryFlagReachesThePassBitForBit) {
   // The fog did something: the default density alone differs.
   EXPECT_GT(differing_floats(run_ok(files() + pose_flags() + " --mode height --device scalar", "plain.exr"), want),
             1000u);
+  // Each flag changes the picture: with its value changed (the boolean --fog-skybox left out) the
+  // output is not the one above.
+  const struct {
+    const char* flag;
+    const char* other;  // nullptr: leave the flag out
+  } changes[] = {
+      {"--extinction", "0.03,0.03,0.05"}, {"--inscattering", "0.02,0.02,0.04"}, {"--height-falloff", "0.3"},
+      {"--base-height", "0.6"},           {"--start", "1.5"},                   {"--cutoff", "300"},
+      {"--max-opacity", "0.5"},           {"--fog-color", "0.6,0.7,0.9"},       {"--fog-skybox", nullptr},
+      {"--light-dir", "0.3,0.5,1"},       {"--sun-color", "1.5,1.2,1"},         {"--sun-exponent", "10"},
+      {"--sun-start", "3"},
+  };
+  const std::string all = kFlags;
+  for (const auto& c : changes) {
+    const std::string flag = std::string(" ") + c.flag;
+    const std::size_t at = all.find(flag + " ");
+    ASSERT_NE(at, std::string::npos) << c.flag;
+    const std::size_t value = at + flag.size() + 1;
+    const std::size_t end = c.other ? all.find(' ', value) : value - 1;
+    const std::string changed =
+        all.substr(0, at) + (c.other ? flag + " " + c.other : "") + (end == std::string::npos ? "" : all.substr(end));
+    const std::size_t d = differing_floats(run_ok(files() + pose_flags() + changed + " --device scalar", "flag.exr"), want);
+    std::printf("[ measured ] %s %s: %zu floats change\n", c.flag, c.other ? c.other : "(left out)", d);
+    EXPECT_GT(d, 0u) << c.flag << " changed nothing: " << changed;
+  }
 }
 
 TEST_F(CliHeight, VolumesFirstThenHeightFog) {

@@ -92,6 +92,7 @@ TEST_F(Cli, ApplyMatchesTheDoublePath) {
     const ErrorStats e = compare_color(got, ref, color, s.color);
     std::printf("[ worst    ] fogcl apply --device %s: rel %.2e\n", device, e.max_rel);
     EXPECT_LE(e.max_rel, 1e-5);
+    EXPECT_EQ(e.alpha_changed, 0u);
     EXPECT_NE(r.output.find("variant: exp2 distance"), std::string::npos) << r.output;
   }
 }
@@ -115,12 +116,16 @@ TEST_F(Cli, BadInputExitsNonZeroWithOneLineAndNoFile) {
     const CliRun r = run_cli(base + c.args + " --out " + out);
     EXPECT_NE(r.exit_code, 0) << c.args;
     EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.args << ": " << r.output;
+    // One line: "fogcl: error: ..." and nothing else.
+    EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << c.args << ": " << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << c.args << ": " << r.output;
     EXPECT_FALSE(fs::exists(out)) << c.args;
   }
   const CliRun missing = run_cli("apply --color " + in("nope.exr") + " --depth " + in("scene-depth.exr") +
                               " --near 0.3 --far 1000 --fov 60 --mode exp --out " + out);
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_NE(missing.output.find("nope.exr"), std::string::npos) << missing.output;
+  EXPECT_EQ(missing.output.rfind("fogcl: error: ", 0), 0u) << missing.output;
   EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
   EXPECT_FALSE(fs::exists(out));
 }

@@ -73,6 +73,7 @@ Budgets check_against_double(bool scalar, const TestFrame& t, const FogSettings&
   const FogResult<double> ref = fog_scalar<double>(t.color, t.depth, t.params, s);
   const ErrorStats e = compare_color(out, ref, t.color, s.color);
   EXPECT_EQ(e.nonfinite_from_finite, 0u);
+  EXPECT_EQ(e.alpha_changed, 0u);
   FogSettings probe = s;
   probe.color = glm::vec3(0.0f);
   const ColorImage white = white_like(convert(t.color, ColorFormat::rgba32f));
@@ -357,6 +358,7 @@ TEST_P(Extreme, OddSizes) {
       for (const FogSettings& s : every_mode(FogMetric::distance, false)) {
         const ColorImage out = run(scalar(), t.color, t.depth, cam, s);
         const ErrorStats e = compare_color(out, fog_scalar<double>(t.color, t.depth, cam, s), t.color, s.color);
+        EXPECT_EQ(e.alpha_changed, 0u) << w << "x" << h;
         if (format == ColorFormat::rgba32f)
           EXPECT_LE(e.max_rel, kColorRelBudget) << w << "x" << h;
         else

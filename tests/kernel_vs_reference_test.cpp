@@ -75,6 +75,7 @@ TEST_P(KernelVsReference, WithinBudget) {
   // One path's errors (color against the reference, fog factor) within the budgets.
   const auto expect_within_budget = [&](const ErrorStats& e, double factor_err, const char* path) {
     EXPECT_EQ(e.nonfinite_from_finite, 0u) << path;
+    EXPECT_EQ(e.alpha_changed, 0u) << path;
     EXPECT_LE(factor_err, kFactorBudget) << path;
     if (f32)
       EXPECT_LE(e.max_rel, kColorRelBudget) << path;

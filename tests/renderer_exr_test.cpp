@@ -119,6 +119,7 @@ class RendererExr : public ::testing::Test {
     std::printf("[ worst    ] %s: rel %.2e over %zu pixels\n", args.substr(0, 60).c_str(), e.max_rel, e.pixels);
     EXPECT_LE(e.max_rel, 1e-5);
     EXPECT_EQ(e.nonfinite_from_finite, 0u);
+    EXPECT_EQ(e.alpha_changed, 0u);
     // Not a no-op: the fog changed the frame.
     double changed = 0;
     for (int y = 0; y < color.height(); ++y)

@@ -24,8 +24,6 @@ constexpr double kFactorBudget = 2e-6;     // the library's budgets (tests/extre
 constexpr double kColorRelBudget = 1e-5;
 constexpr double kSmallestScale = 0.62;    // the report's fog color's smallest channel
 
-bool matplotlib_available() { return std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0; }
-
 TEST(Report, WritesCsvJsonAndPlotWithSaneValues) {
   FOGCL_REQUIRE_DEVICE();
   ReportOptions o;
@@ -102,10 +100,11 @@ TEST(Report, WritesCsvJsonAndPlotWithSaneValues) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("python3-matplotlib"), std::string::npos) << e.what();
   }
-  if (!matplotlib_available()) GTEST_SKIP() << "/usr/bin/python3 has no matplotlib (apt-get install python3-matplotlib)";
+  if (!require_matplotlib()) return;
   plot_report(dir);
   ASSERT_TRUE(fs::exists(dir + "/report.png"));
-  EXPECT_GT(fs::file_size(dir + "/report.png"), 10000u);
+  // src/report/plot_report.py: one 5.2 x 4.0 inch panel per scene, 110 dpi.
+  expect_plot(dir + "/report.png", int(scenes), 5.2, 4.0, 110);
 }
 
 TEST(ErrorBudget, PicksTheFastestCachesAndRefusesTheImpossible) {
@@ -225,6 +224,7 @@ class CliCameraAndBudgetFlags : public ::testing::Test {
     std::printf("[ worst    ] fogcl apply %s: rel %.2e\n", args.c_str(), e.max_rel);
     EXPECT_LE(e.max_rel, kColorRelBudget) << args;
     EXPECT_EQ(e.nonfinite_from_finite, 0u);
+    EXPECT_EQ(e.alpha_changed, 0u) << args;
   }
 
   static inline std::string dir_, demo_output_;
@@ -320,6 +320,7 @@ TEST_F(CliCameraAndBudgetFlags, MaxErrorPicksTheVariantFromTheCache) {
   const ErrorStats e = compare_color(read_exr_color(out), ref, color, exp_fog().color);
   std::printf("[ worst    ] --max-error 1 (%s): rel %.2e\n", to_string(fastest.precision), e.max_rel);
   EXPECT_LE(e.max_rel, kColorRelBudget);
+  EXPECT_EQ(e.alpha_changed, 0u);
 
   // Without a budget: precise, and said so.
   const CliRun plain = run_cli(common + " --out " + in("plain.exr"), env);

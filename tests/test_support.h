@@ -62,11 +62,14 @@ struct ErrorStats {
   // factor budget, so plain ulps would hold half to a stricter standard than float.
   double max_half_ulps_beyond_factor = 0;
   std::size_t nonfinite_from_finite = 0;
+  // Pixels whose alpha is not the input's bits (a NaN alpha of half storage may come out quieted,
+  // docs/accuracy.md): alpha passes through the blend, so every caller expects 0.
+  std::size_t alpha_changed = 0;
   std::size_t pixels = 0;
 };
 
-// Compares the RGB of `got` against the double reference (alpha must match `in` bit for bit;
-// counted as an error otherwise).
+// Compares the RGB of `got` against the double reference, and counts in alpha_changed the pixels
+// whose alpha is not `in`'s.
 ErrorStats compare_color(const ColorImage& got, const FogResult<double>& ref, const ColorImage& in,
                          const glm::vec3& fog_color);
 
@@ -130,6 +133,15 @@ std::size_t differing_floats(const ColorImage& a, const ColorImage& b);
 // The demo scene at width x height (render_demo_scene's defaults) written into `dir` as
 // scene.exr (RGBA) and scene-depth.exr.
 DemoFrame write_demo_scene(const std::string& dir, int width, int height);
+
+// Checks a plot the report tools drew with matplotlib (src/report/plot_*.py): the PNG decodes, is
+// the size of `panels` panels of panel_w x panel_h inches at `dpi` in rows of at most 3 (±1 px),
+// and is not blank: at least 2 % of its pixels differ from the most common one and the gray
+// levels' standard deviation is at least 5 (of 255). Prints what it measured.
+void expect_plot(const std::string& png, int panels, double panel_w, double panel_h, int dpi);
+// Whether /usr/bin/python3 imports matplotlib (scripts/setup.sh installs python3-matplotlib); a
+// test failure saying so where it does not.
+bool require_matplotlib();
 
 // The fogcl CLI run with `args` (and `env` assignments before it), stdout + stderr captured.
 struct CliRun {

@@ -29,6 +29,18 @@ struct VariantCase {
 };
 
 // integrator x noise x shadow map x resolution x storage.
+// Budgets (docs/accuracy.md#volume-budgets). On CPU devices (PoCL, where they were measured) every
+// pixel's max |got - ref| over RGB is within the CPU budget. Other devices (GPUs) keep the budget
+// their runs were checked against, 0.1 % of the pixels may exceed it but none by more than 10x.
+void expect_within(const VolumeErrorStats& s, double cpu_budget, double device_tolerance) {
+  if (runtime()->is_cpu()) {
+    EXPECT_LE(s.max_abs, cpu_budget) << describe(s);
+  } else {
+    EXPECT_LE(s.over, s.pixels / 1000) << describe(s);
+    EXPECT_LE(s.max_abs, 10 * device_tolerance) << describe(s);
+  }
+}
+
 class VolumeKernelVsReference
     : public ::testing::TestWithParam<std::tuple<VolumeIntegrator, bool, bool, int, ColorFormat>> {};
 
@@ -54,7 +66,8 @@ TEST_P(VolumeKernelVsReference, WithinBudget) {
               to_string(storage), describe(s).c_str());
   EXPECT_GT(s.fogged, s.pixels / 10);
   EXPECT_EQ(s.nonfinite, 0u);
-  EXPECT_LE(s.over, s.pixels / 1000) << describe(s);
+  // PoCL: worst 5.6e-7 (float storage), 4.9e-4 (half: its rounding at values up to 2).
+  expect_within(s, storage == ColorFormat::rgba16f ? 1e-3 : 4e-6, tolerance);
 }
 
 // Shadow maps (both Z conventions), reversed-Z frames and the noise as an image: on the
@@ -87,7 +100,8 @@ TEST_P(VolumeKernelFeatures, WithinBudget) {
   std::printf("  %s, %s: %s (options: %s)\n", to_string(integrator), names[feature], describe(s).c_str(),
               volume_pass().last_march_options().c_str());
   EXPECT_EQ(s.nonfinite, 0u);
-  EXPECT_LE(s.over, s.pixels / 1000) << describe(s);
+  // PoCL: worst 4.0e-7 (PoCL samples the image in float like the buffer path: 1.5e-7 there).
+  expect_within(s, 4e-6, tolerance);
   if (with_shadow) {
     // The shadow really darkens something: the same frame without it differs.
     const VolumeResult<double> lit = volumes_scalar<double>(t.frame.color, t.frame.depth, t.frame.params, t.scene, settings);
@@ -194,8 +208,9 @@ TEST(VolumeNoiseSampling, AutomaticResolvesFromTheDeviceFacts) {
 // The default (automatic) on the tests' device: the pass reads the device's facts right (CPU
 // devices keep the buffer, bit for bit), the build options are the resolved sampling's, and the
 // output is the explicit choice's bit for bit and within that sampling's budget of the scalar
-// double march: 2e-4 for the buffer (exact trilinear), 2e-2 for the image (the texture unit's
-// filter weights; docs/accuracy.md#noise-sampling-on-gpus).
+// double march: on CPU devices 2e-6 (measured there), on others 2e-4 for the buffer (exact
+// trilinear), 2e-2 for the image (the texture unit's filter weights;
+// docs/accuracy.md#noise-sampling-on-gpus).
 TEST(VolumeNoiseSampling, AutomaticIsTheDevicesChoiceWithinItsBudget) {
   FOGCL_REQUIRE_DEVICE();
   const cl::Device device = wrap(runtime()->device());
@@ -217,7 +232,8 @@ TEST(VolumeNoiseSampling, AutomaticIsTheDevicesChoiceWithinItsBudget) {
   }
   EXPECT_EQ(pass.noise_sampling(NoiseSampling::buffer), NoiseSampling::buffer);
   EXPECT_EQ(pass.noise_sampling(NoiseSampling::image), NoiseSampling::image);
-  const double budget = chosen == NoiseSampling::image ? 2e-2 : 2e-4;
+  // PoCL (the buffer): worst 2.3e-7.
+  const double budget = runtime()->is_cpu() ? 2e-6 : chosen == NoiseSampling::image ? 2e-2 : 2e-4;
   for (const VolumeIntegrator integrator : {VolumeIntegrator::stylized, VolumeIntegrator::physical}) {
     const VolumeTestScene t = volume_test_scene(160, 90);
     VolumeSettings settings;
