@@ -43,6 +43,16 @@ for lib in "$here"/lib/*; do
 done
 export LD_LIBRARY_PATH="$scratch/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 
+# --- Vulkan: its loader and GLVND from the bundle (gl/*.deb) where the machine has none; the
+# interop tests and bench take their shared semaphores from Vulkan (CUDA makes none to export) --
+if ! ldconfig -p | grep -q "libvulkan.so.1 " && ls "$here"/gl/*.deb >/dev/null 2>&1; then
+  for deb in "$here"/gl/*.deb; do dpkg -x "$deb" /; done
+  ldconfig
+fi
+for icd in /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json /usr/share/vulkan/icd.d/nvidia_icd.json; do
+  [ -e "$icd" ] && { export VK_DRIVER_FILES="$icd"; break; }
+done
+
 {
   echo "commit: $(cat "$here/COMMIT" 2>/dev/null)"
   echo "date: $(date -u +%FT%TZ)"
@@ -90,6 +100,8 @@ if want bench; then
   FOGCL_DEVICE=gpu bench fogcl_volume_bench volume-gpu.json 'BM_VolumeDevice|BM_VolumeHostCall|BM_VolumeNothingVisible' \
     --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
   bench fogcl_volume_bench volume-scalar.json 'BM_VolumeScalar'
+  echo "bench: a CUDA producer's frame fogged in its memory, signal to signal"
+  FOGCL_DEVICE=gpu bench fogcl_interop_bench interop-gpu.json 'BM_ExternalSignalToSignal'
 fi
 
 # --- PoCL on every core: the volumetric march from 1 thread to all -----------------------------

@@ -1,0 +1,197 @@
+// A GPU renderer's frame fogged where it lies (fogcl/external_memory.h), timed on the GPU:
+//   BM_ExternalSignalToSignal  from the producer's "frame ready" signal to fogcl's "fog done" as the
+//                              producer sees it: CUDA events around CUDA's semaphore signal and
+//                              wait, with fogcl's wait, acquire, deferred pass, release and signal
+//                              in between (manual time). A host callback holds the CUDA stream
+//                              until fogcl's commands are enqueued, so the figure is the GPU's
+//                              hand-over, not the host's enqueue. Counters: pass_ms, the deferred
+//                              pass's kernel on the same buffers (profiling START -> END, median of
+//                              20), and over_pass_us, the hand-over's cost beyond the kernel.
+// The producer is CUDA (libcuda.so.1), the semaphores Vulkan's (libvulkan.so.1), as in
+// tests/gpu_interop_test.cpp; without them, or on a device without cl_khr_external_memory, the
+// rows report why they were skipped. FOGCL_DEVICE chooses the device (gpu on the GPU machine).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "../examples/cuda_driver.h"
+#include "../examples/vulkan_semaphores.h"
+#include "fogcl/external_memory.h"
+#include "fogcl/fogcl.h"
+
+namespace {
+
+using namespace fogcl;
+
+// The process-wide producer and consumer: OpenCL device, CUDA context, Vulkan semaphores.
+struct Interop {
+  std::unique_ptr<Runtime> runtime;
+  cl_command_queue profiling_queue = nullptr;
+  cuda::Driver cu;
+  cuda::CUdevice device = 0;
+  cuda::CUcontext context = nullptr;
+  cuda::CUstream stream = nullptr;
+  vk::ExportableSemaphores vulkan;
+  std::unique_ptr<ExternalSemaphore> ready, done;
+  cuda::CUexternalSemaphore cu_ready = nullptr, cu_done = nullptr;
+  std::string why_not;
+};
+
+Interop& interop() {
+  static Interop* it = [] {
+    auto* s = new Interop;
+    try {
+      s->runtime = std::make_unique<Runtime>();
+      const cl_device_id device = s->runtime->device();
+      const ExternalSupport support = external_support(device);
+      if (!support.imports_memory(ExternalHandle::opaque_fd) || !support.imports_semaphore(ExternalHandle::opaque_fd)) {
+        s->why_not = device_name(device) + ": " + support.describe();
+        return s;
+      }
+      unsigned char uuid[16] = {};
+      clGetDeviceInfo(device, CL_DEVICE_UUID_KHR, sizeof uuid, uuid, nullptr);
+      if (!s->cu.load(s->why_not)) return s;
+      if (!(s->why_not = s->cu.open_device(uuid, s->device, s->context)).empty()) return s;
+      if (!s->vulkan.open(uuid, s->why_not)) return s;
+      cl_int err = CL_SUCCESS;
+      const cl_queue_properties profiling[] = {CL_QUEUE_PROPERTIES, CL_QUEUE_PROFILING_ENABLE, 0};
+      s->profiling_queue = clCreateCommandQueueWithProperties(s->runtime->context(), device, profiling, &err);
+      if (err != CL_SUCCESS) {
+        s->why_not = std::string("no profiling queue: ") + cl_error_name(err);
+        return s;
+      }
+      const int ready = s->vulkan.create(), done = s->vulkan.create();
+      s->ready = std::make_unique<ExternalSemaphore>(
+          ExternalSemaphore::import_fd(s->runtime->context(), device, s->vulkan.export_fd(ready)));
+      s->done = std::make_unique<ExternalSemaphore>(
+          ExternalSemaphore::import_fd(s->runtime->context(), device, s->vulkan.export_fd(done)));
+      cuda::CUDA_EXTERNAL_SEMAPHORE_HANDLE_DESC desc{};
+      desc.type = cuda::CU_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD;
+      desc.handle.fd = s->vulkan.export_fd(ready);
+      std::string e = s->cu.error(s->cu.cuImportExternalSemaphore(&s->cu_ready, &desc), "cuImportExternalSemaphore");
+      desc.handle.fd = s->vulkan.export_fd(done);
+      if (e.empty()) e = s->cu.error(s->cu.cuImportExternalSemaphore(&s->cu_done, &desc), "cuImportExternalSemaphore");
+      if (e.empty()) e = s->cu.error(s->cu.cuStreamCreate(&s->stream, cuda::CU_STREAM_NON_BLOCKING), "cuStreamCreate");
+      s->why_not = e;
+    } catch (const std::exception& e) {
+      s->why_not = e.what();
+    }
+    return s;
+  }();
+  if (it->context != nullptr) it->cu.cuCtxSetCurrent(it->context);
+  return *it;
+}
+
+// Holds the CUDA stream until the host has enqueued fogcl's side (cuLaunchHostFunc).
+std::atomic<int> gate{0};
+void wait_for_gate(void*) {
+  while (gate.load(std::memory_order_acquire) == 0) {
+  }
+  gate.store(0, std::memory_order_relaxed);
+}
+
+void BM_ExternalSignalToSignal(benchmark::State& state) {
+  Interop& x = interop();
+  if (!x.why_not.empty()) {
+    state.SkipWithError(("no CUDA interop: " + x.why_not).c_str());
+    return;
+  }
+  const int w = int(state.range(0)), h = int(state.range(1));
+  const ColorFormat format = state.range(2) != 0 ? ColorFormat::rgba16f : ColorFormat::rgba32f;
+  const cl_context context = x.runtime->context();
+  const cl_device_id device = x.runtime->device();
+  const std::size_t color_bytes = color_buffer_bytes(w, h, format);
+  const std::size_t depth_at = (color_bytes + 65535) / 65536 * 65536;
+  cuda::ExportableAllocation memory;
+  if (const std::string e = memory.create(x.cu, x.device, depth_at + depth_buffer_bytes(w, h)); !e.empty()) {
+    state.SkipWithError(e.c_str());
+    return;
+  }
+  // A frame with sky and a depth ramp (the pass's time does not depend on the pixels' values).
+  PerspectiveCamera lens;
+  lens.aspect = float(w) / float(h);
+  const CameraParams camera = make_camera_params(lens);
+  ColorImage color(w, h, format);
+  DepthImage depth(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int px = 0; px < w; ++px) {
+      color.set_pixel(px, y, {0.3f, 0.5f, 0.8f, 1.0f});
+      depth.at(px, y) = y < h / 3 ? 1.0f : float(y) / float(h);
+    }
+  x.cu.cuMemcpyHtoD(memory.ptr, color.data(), color_bytes);
+  x.cu.cuMemcpyHtoD(memory.ptr + depth_at, depth.data(), depth.size_bytes());
+  const ExternalMemory imported(context, device, memory.export_fd(), memory.size);
+  ExternalFrameLayout layout;
+  layout.width = w;
+  layout.height = h;
+  layout.format = format;
+  layout.color_in = {&imported, 0, 0};
+  layout.depth = {&imported, depth_at, 0};
+  ExternalFrame frame(context, device, layout);
+  FogPass pass(context, device);
+  FogSettings settings;  // exp2, Unity's default
+  settings.density = 0.002f;
+  pass.prepare(settings, camera, format);
+  const ExternalSync sync{{x.ready.get()}, {x.done.get()}, {}};
+  cuda::CUevent start = nullptr, stop = nullptr;
+  x.cu.cuEventCreate(&start, 0);
+  x.cu.cuEventCreate(&stop, 0);
+  auto one_frame = [&]() -> double {
+    cuda::CUDA_EXTERNAL_SEMAPHORE_SIGNAL_PARAMS signal{};
+    cuda::CUDA_EXTERNAL_SEMAPHORE_WAIT_PARAMS wait{};
+    x.cu.cuLaunchHostFunc(x.stream, wait_for_gate, nullptr);
+    x.cu.cuEventRecord(start, x.stream);
+    x.cu.cuSignalExternalSemaphoresAsync(&x.cu_ready, &signal, 1, x.stream);
+    x.cu.cuWaitExternalSemaphoresAsync(&x.cu_done, &wait, 1, x.stream);
+    x.cu.cuEventRecord(stop, x.stream);
+    clReleaseEvent(frame.enqueue(pass, x.runtime->queue(), camera, settings, sync));
+    gate.store(1, std::memory_order_release);
+    x.cu.cuEventSynchronize(stop);
+    float ms = 0;
+    x.cu.cuEventElapsedTime(&ms, start, stop);
+    return double(ms) * 1e-3;
+  };
+  for (int i = 0; i < 3; ++i) one_frame();  // warm: first acquire, first kernel
+  std::vector<double> times;
+  for (auto _ : state) {
+    times.push_back(one_frame());
+    state.SetIterationTime(times.back());
+  }
+  // The deferred pass alone on the same buffers: its kernel's device time.
+  std::vector<double> pass_s;
+  for (int i = 0; i < 20; ++i) {
+    cl_event e = pass.enqueue(x.profiling_queue, frame.buffers(), camera, settings);
+    clWaitForEvents(1, &e);
+    cl_ulong t0 = 0, t1 = 0;
+    clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_START, sizeof t0, &t0, nullptr);
+    clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_END, sizeof t1, &t1, nullptr);
+    clReleaseEvent(e);
+    pass_s.push_back(double(t1 - t0) * 1e-9);
+  }
+  std::nth_element(pass_s.begin(), pass_s.begin() + 10, pass_s.end());
+  std::nth_element(times.begin(), times.begin() + std::ptrdiff_t(times.size() / 2), times.end());
+  state.counters["pass_ms"] = pass_s[10] * 1e3;
+  state.counters["median_ms"] = times[times.size() / 2] * 1e3;
+  state.counters["over_pass_us"] = (times[times.size() / 2] - pass_s[10]) * 1e6;
+  x.cu.cuEventDestroy(start);
+  x.cu.cuEventDestroy(stop);
+}
+
+BENCHMARK(BM_ExternalSignalToSignal)
+    ->ArgNames({"w", "h", "f16"})
+    ->Args({1920, 1080, 0})
+    ->Args({1920, 1080, 1})
+    ->Args({3840, 2160, 0})
+    ->Args({3840, 2160, 1})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(200);
+
+}  // namespace
+
+BENCHMARK_MAIN();
