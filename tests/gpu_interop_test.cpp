@@ -17,6 +17,7 @@
 #include "../examples/vulkan_semaphores.h"
 #include "fogcl/external_memory.h"
 #include "test_support.h"
+#include "volume_support.h"
 
 namespace fogcl::test {
 namespace {
@@ -333,6 +334,49 @@ TEST(GpuInterop, HundredFramesWithSemaphoresNoHostWait) {
   }
   c.cu.cuDestroyExternalSemaphore(cu_ready);
   c.cu.cuDestroyExternalSemaphore(cu_done);
+}
+
+// The fog volumes on a frame in CUDA's memory, in place, against VolumePass::apply on host images
+// (which culls with the depth image's range, the external frame with none: the same march, up to
+// the variant's culling, hence a budget rather than bits).
+TEST(GpuInterop, VolumePassInCudaMemoryMatchesHostApply) {
+  FOGCL_REQUIRE_CUDA_INTEROP();
+  CudaSide& c = cuda_side();
+  const VolumeTestScene t = volume_test_scene(960, 540);
+  const int w = t.frame.color.width(), h = t.frame.color.height();
+  VolumeSettings settings;
+  settings.steps = 48;
+  VolumePass pass(*runtime(), shared_pass().program_cache());
+  ColorImage expected;
+  pass.apply(t.frame.color, t.frame.depth, expected, t.frame.params, t.scene, settings);
+  const std::size_t color_bytes = t.frame.color.size_bytes(), depth_at = (color_bytes + 65535) / 65536 * 65536;
+  cuda::ExportableAllocation alloc;
+  ASSERT_EQ(alloc.create(c.cu, c.device, depth_at + t.frame.depth.size_bytes()), "");
+  CU_OK(c.cu.cuMemcpyHtoD(alloc.ptr, t.frame.color.data(), color_bytes));
+  CU_OK(c.cu.cuMemcpyHtoD(alloc.ptr + depth_at, t.frame.depth.data(), t.frame.depth.size_bytes()));
+  ExternalMemory memory(runtime()->context(), runtime()->device(), alloc.export_fd(), alloc.size);
+  ExternalFrameLayout layout;
+  layout.width = w;
+  layout.height = h;
+  layout.format = t.frame.color.format();
+  layout.color_in = {&memory, 0, 0};
+  layout.depth = {&memory, depth_at, 0};
+  ExternalFrame frame(runtime()->context(), runtime()->device(), layout);
+  pass.prepare(t.frame.params, t.scene, settings, layout.format);
+  cl_event done = frame.enqueue(pass, runtime()->queue(), t.frame.params, t.scene, settings);
+  ASSERT_EQ(clWaitForEvents(1, &done), CL_SUCCESS);
+  clReleaseEvent(done);
+  ColorImage got(w, h, layout.format);
+  CU_OK(c.cu.cuMemcpyDtoH(got.data(), alloc.ptr, color_bytes));
+  double worst = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const glm::vec4 d = glm::abs(got.pixel(x, y) - expected.pixel(x, y));
+      worst = std::max({worst, double(d.r), double(d.g), double(d.b), double(d.a)});
+    }
+  EXPECT_LE(worst, 1e-5);
+  std::printf("[ info ] volumes %dx%d in CUDA memory: %zu values differ from VolumePass::apply, worst %.3g\n", w, h,
+              differing_floats(got, expected), worst);
 }
 
 // examples/cuda_interop.cpp, as an integrator would run it: exit status 0 (its frame equal to
