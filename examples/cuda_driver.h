@@ -124,6 +124,7 @@ struct Driver {
   CUresult (*cuMemSetAccess)(CUdeviceptr, std::size_t, const CUmemAccessDesc*, std::size_t) = nullptr;
   CUresult (*cuMemAlloc)(CUdeviceptr*, std::size_t) = nullptr;
   CUresult (*cuMemFree)(CUdeviceptr) = nullptr;
+  CUresult (*cuMemsetD8)(CUdeviceptr, unsigned char, std::size_t) = nullptr;
   CUresult (*cuMemcpyHtoD)(CUdeviceptr, const void*, std::size_t) = nullptr;
   CUresult (*cuMemcpyDtoH)(void*, CUdeviceptr, std::size_t) = nullptr;
   CUresult (*cuMemcpyDtoDAsync)(CUdeviceptr, CUdeviceptr, std::size_t, CUstream) = nullptr;
@@ -179,6 +180,7 @@ struct Driver {
     get(cuMemSetAccess, "cuMemSetAccess");
     get(cuMemAlloc, "cuMemAlloc_v2");
     get(cuMemFree, "cuMemFree_v2");
+    get(cuMemsetD8, "cuMemsetD8_v2");
     get(cuMemcpyHtoD, "cuMemcpyHtoD_v2");
     get(cuMemcpyDtoH, "cuMemcpyDtoH_v2");
     get(cuMemcpyDtoDAsync, "cuMemcpyDtoDAsync_v2");
