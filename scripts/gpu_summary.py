@@ -198,6 +198,8 @@ if inter:
     p("| frame | storage | signal to signal ms | deferred pass ms | beyond the pass µs | target: pass + 50 µs |")
     p("|---|---|---:|---:|---:|---|")
     for b in inter:
+        if not b["base"].startswith("BM_ExternalSignalToSignal/"):
+            continue
         a = args(b["base"])
         if "error_message" in b or "pass_ms" not in b:
             p(f'| {a.get("w")}x{a.get("h")} | | skipped: {b.get("error_message", "no figures")} | | | |')
@@ -206,6 +208,13 @@ if inter:
         verdict = "met" if over <= 50 else "FAILED"
         p(f'| {a["w"]}x{a["h"]} | {"f16" if a["f16"] == "1" else "f32"} | {b["median_ms"]:.4f} | {b["pass_ms"]:.4f} '
           f'| {over:.1f} | {verdict} |')
+    p()
+    parts = {"0": "CUDA signals and waits alone", "1": "+ OpenCL waits and signals", "2": "+ acquire, release",
+             "3": "+ the deferred pass (ExternalFrame::enqueue)", "4": "no semaphores: the host waits both ways"}
+    for b in inter:
+        if b["base"].startswith("BM_ExternalHandOverParts/"):
+            part = args(b["base"])["part"]
+            p(f'- hand-over part {part}, {parts.get(part, "?")} (1080p f16): {ms(b) * 1e3:.1f} µs')
     p()
     for b in inter:
         a = args(b["base"])
