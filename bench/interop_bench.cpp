@@ -194,7 +194,9 @@ void BM_ExternalSignalToSignal(benchmark::State& state) {
 // clEnqueueSignalSemaphoresKHR, nothing between); 2, plus acquire and release around a marker;
 // 3, the whole ExternalFrame::enqueue of BM_ExternalSignalToSignal; 4, the fallback without
 // semaphores: the host waits for the producer's point (a CUDA event), enqueues the frame, waits
-// for its event, then lets the producer's stream go on (a host callback's gate).
+// for its event, then lets the producer's stream go on (a host callback's gate); 5, OpenCL signals
+// alone (CUDA waits from the moment the host has flushed the signal); 6, part 1 on a queue
+// without profiling.
 void BM_ExternalHandOverParts(benchmark::State& state) {
   Interop& x = interop();
   if (!x.why_not.empty()) {
@@ -236,6 +238,8 @@ void BM_ExternalHandOverParts(benchmark::State& state) {
   auto signal_fn = reinterpret_cast<clEnqueueSignalSemaphoresKHR_fn>(
       clGetExtensionFunctionAddressForPlatform(platform, "clEnqueueSignalSemaphoresKHR"));
   const ExternalSync sync{{x.ready.get()}, {x.done.get()}, {}};
+  cl_int err = CL_SUCCESS;
+  const cl_command_queue plain_queue = clCreateCommandQueueWithProperties(context, device, nullptr, &err);
   cuda::CUevent start = nullptr, stop = nullptr;
   x.cu.cuEventCreate(&start, 0);
   x.cu.cuEventCreate(&stop, 0);
@@ -256,16 +260,31 @@ void BM_ExternalHandOverParts(benchmark::State& state) {
       x.cu.cuEventElapsedTime(&ms, start, stop);
       return double(ms) * 1e-3;
     }
+    if (part == 5) {
+      x.cu.cuLaunchHostFunc(x.stream, wait_for_gate, nullptr);
+      x.cu.cuEventRecord(start, x.stream);
+      x.cu.cuWaitExternalSemaphoresAsync(&x.cu_done, &wait, 1, x.stream);
+      x.cu.cuEventRecord(stop, x.stream);
+      cl_semaphore_khr d = x.done->handle();
+      signal_fn(queue, 1, &d, nullptr, 0, nullptr, nullptr);
+      clFlush(queue);
+      gate.store(1, std::memory_order_release);
+      x.cu.cuEventSynchronize(stop);
+      float ms = 0;
+      x.cu.cuEventElapsedTime(&ms, start, stop);
+      return double(ms) * 1e-3;
+    }
     x.cu.cuLaunchHostFunc(x.stream, wait_for_gate, nullptr);
     x.cu.cuEventRecord(start, x.stream);
     x.cu.cuSignalExternalSemaphoresAsync(&x.cu_ready, &signal, 1, x.stream);
     x.cu.cuWaitExternalSemaphoresAsync(part == 0 ? &x.cu_ready : &x.cu_done, &wait, 1, x.stream);
     x.cu.cuEventRecord(stop, x.stream);
-    if (part == 1) {
+    if (part == 1 || part == 6) {
+      const cl_command_queue q = part == 6 ? plain_queue : queue;
       cl_semaphore_khr r = x.ready->handle(), d = x.done->handle();
-      wait_fn(queue, 1, &r, nullptr, 0, nullptr, nullptr);
-      signal_fn(queue, 1, &d, nullptr, 0, nullptr, nullptr);
-      clFlush(queue);
+      wait_fn(q, 1, &r, nullptr, 0, nullptr, nullptr);
+      signal_fn(q, 1, &d, nullptr, 0, nullptr, nullptr);
+      clFlush(q);
     } else if (part == 2) {
       clReleaseEvent(frame.enqueue(
           queue,
@@ -288,11 +307,12 @@ void BM_ExternalHandOverParts(benchmark::State& state) {
   for (auto _ : state) state.SetIterationTime(one_frame());
   x.cu.cuEventDestroy(start);
   x.cu.cuEventDestroy(stop);
+  clReleaseCommandQueue(plain_queue);
 }
 
 BENCHMARK(BM_ExternalHandOverParts)
     ->ArgName("part")
-    ->DenseRange(0, 4)
+    ->DenseRange(0, 6)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(200);

@@ -210,7 +210,8 @@ if inter:
           f'| {over:.1f} | {verdict} |')
     p()
     parts = {"0": "CUDA signals and waits alone", "1": "+ OpenCL waits and signals", "2": "+ acquire, release",
-             "3": "+ the deferred pass (ExternalFrame::enqueue)", "4": "no semaphores: the host waits both ways"}
+             "3": "+ the deferred pass (ExternalFrame::enqueue)", "4": "no semaphores: the host waits both ways",
+             "5": "OpenCL signals alone", "6": "part 1 on a queue without profiling"}
     for b in inter:
         if b["base"].startswith("BM_ExternalHandOverParts/"):
             part = args(b["base"])["part"]
