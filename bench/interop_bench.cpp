@@ -196,7 +196,9 @@ void BM_ExternalSignalToSignal(benchmark::State& state) {
 // semaphores: the host waits for the producer's point (a CUDA event), enqueues the frame, waits
 // for its event, then lets the producer's stream go on (a host callback's gate); 5, OpenCL signals
 // alone (CUDA waits from the moment the host has flushed the signal); 6, part 1 on a queue
-// without profiling.
+// without profiling; 7, OpenCL waits for "ready" and then writes a counter into the imported
+// memory (clEnqueueFillBuffer), which CUDA waits for on the GPU (cuStreamWaitValue32) instead of a
+// semaphore.
 void BM_ExternalHandOverParts(benchmark::State& state) {
   Interop& x = interop();
   if (!x.why_not.empty()) {
@@ -238,6 +240,11 @@ void BM_ExternalHandOverParts(benchmark::State& state) {
   auto signal_fn = reinterpret_cast<clEnqueueSignalSemaphoresKHR_fn>(
       clGetExtensionFunctionAddressForPlatform(platform, "clEnqueueSignalSemaphoresKHR"));
   const ExternalSync sync{{x.ready.get()}, {x.done.get()}, {}};
+  auto acquire_fn = reinterpret_cast<clEnqueueAcquireExternalMemObjectsKHR_fn>(
+      clGetExtensionFunctionAddressForPlatform(platform, "clEnqueueAcquireExternalMemObjectsKHR"));
+  auto release_fn = reinterpret_cast<clEnqueueReleaseExternalMemObjectsKHR_fn>(
+      clGetExtensionFunctionAddressForPlatform(platform, "clEnqueueReleaseExternalMemObjectsKHR"));
+  cl_uint counter = 0;
   cl_int err = CL_SUCCESS;
   const cl_command_queue plain_queue = clCreateCommandQueueWithProperties(context, device, nullptr, &err);
   cuda::CUevent start = nullptr, stop = nullptr;
@@ -277,7 +284,12 @@ void BM_ExternalHandOverParts(benchmark::State& state) {
     x.cu.cuLaunchHostFunc(x.stream, wait_for_gate, nullptr);
     x.cu.cuEventRecord(start, x.stream);
     x.cu.cuSignalExternalSemaphoresAsync(&x.cu_ready, &signal, 1, x.stream);
-    x.cu.cuWaitExternalSemaphoresAsync(part == 0 ? &x.cu_ready : &x.cu_done, &wait, 1, x.stream);
+    if (part == 7) {
+      ++counter;
+      x.cu.cuStreamWaitValue32(x.stream, memory.ptr + memory.size - 256, counter, 0);
+    } else {
+      x.cu.cuWaitExternalSemaphoresAsync(part == 0 ? &x.cu_ready : &x.cu_done, &wait, 1, x.stream);
+    }
     x.cu.cuEventRecord(stop, x.stream);
     if (part == 1 || part == 6) {
       const cl_command_queue q = part == 6 ? plain_queue : queue;
@@ -294,6 +306,17 @@ void BM_ExternalHandOverParts(benchmark::State& state) {
             return e;
           },
           sync));
+    } else if (part == 7) {
+      cl_semaphore_khr r = x.ready->handle();
+      cl_event waited = nullptr, filled = nullptr;
+      wait_fn(queue, 1, &r, nullptr, 0, nullptr, &waited);
+      const cl_mem whole = imported.buffer();
+      acquire_fn(queue, 1, &whole, 1, &waited, nullptr);
+      clEnqueueFillBuffer(queue, whole, &counter, sizeof counter, memory.size - 256, sizeof counter, 0, nullptr, &filled);
+      release_fn(queue, 1, &whole, 1, &filled, nullptr);
+      clReleaseEvent(waited);
+      clReleaseEvent(filled);
+      clFlush(queue);
     } else if (part == 3) {
       clReleaseEvent(frame.enqueue(pass, queue, camera, settings, sync));
     }
@@ -312,7 +335,7 @@ void BM_ExternalHandOverParts(benchmark::State& state) {
 
 BENCHMARK(BM_ExternalHandOverParts)
     ->ArgName("part")
-    ->DenseRange(0, 6)
+    ->DenseRange(0, 7)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(200);

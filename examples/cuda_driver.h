@@ -137,6 +137,7 @@ struct Driver {
   CUresult (*cuEventSynchronize)(CUevent) = nullptr;
   CUresult (*cuEventElapsedTime)(float*, CUevent, CUevent) = nullptr;
   CUresult (*cuLaunchHostFunc)(CUstream, CUhostFn, void*) = nullptr;
+  CUresult (*cuStreamWaitValue32)(CUstream, CUdeviceptr, unsigned, unsigned) = nullptr;  // flags 0: >=
   CUresult (*cuImportExternalSemaphore)(CUexternalSemaphore*, const CUDA_EXTERNAL_SEMAPHORE_HANDLE_DESC*) = nullptr;
   CUresult (*cuDestroyExternalSemaphore)(CUexternalSemaphore) = nullptr;
   CUresult (*cuSignalExternalSemaphoresAsync)(const CUexternalSemaphore*, const CUDA_EXTERNAL_SEMAPHORE_SIGNAL_PARAMS*,
@@ -193,6 +194,7 @@ struct Driver {
     get(cuEventSynchronize, "cuEventSynchronize");
     get(cuEventElapsedTime, "cuEventElapsedTime");
     get(cuLaunchHostFunc, "cuLaunchHostFunc");
+    get(cuStreamWaitValue32, "cuStreamWaitValue32_v2");
     get(cuImportExternalSemaphore, "cuImportExternalSemaphore");
     get(cuDestroyExternalSemaphore, "cuDestroyExternalSemaphore");
     get(cuSignalExternalSemaphoresAsync, "cuSignalExternalSemaphoresAsync");

@@ -211,7 +211,8 @@ if inter:
     p()
     parts = {"0": "CUDA signals and waits alone", "1": "+ OpenCL waits and signals", "2": "+ acquire, release",
              "3": "+ the deferred pass (ExternalFrame::enqueue)", "4": "no semaphores: the host waits both ways",
-             "5": "OpenCL signals alone", "6": "part 1 on a queue without profiling"}
+             "5": "OpenCL signals alone", "6": "part 1 on a queue without profiling",
+             "7": "OpenCL waits, then writes a counter CUDA waits for (no OpenCL signal)"}
     for b in inter:
         if b["base"].startswith("BM_ExternalHandOverParts/"):
             part = args(b["base"])["part"]
