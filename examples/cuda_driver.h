@@ -131,6 +131,7 @@ struct Driver {
   CUresult (*cuStreamCreate)(CUstream*, unsigned) = nullptr;
   CUresult (*cuStreamDestroy)(CUstream) = nullptr;
   CUresult (*cuStreamSynchronize)(CUstream) = nullptr;
+  CUresult (*cuStreamQuery)(CUstream) = nullptr;  // CUDA_SUCCESS when done, else not ready (600)
   CUresult (*cuEventCreate)(CUevent*, unsigned) = nullptr;
   CUresult (*cuEventDestroy)(CUevent) = nullptr;
   CUresult (*cuEventRecord)(CUevent, CUstream) = nullptr;
@@ -188,6 +189,7 @@ struct Driver {
     get(cuStreamCreate, "cuStreamCreate");
     get(cuStreamDestroy, "cuStreamDestroy_v2");
     get(cuStreamSynchronize, "cuStreamSynchronize");
+    get(cuStreamQuery, "cuStreamQuery");
     get(cuEventCreate, "cuEventCreate");
     get(cuEventDestroy, "cuEventDestroy_v2");
     get(cuEventRecord, "cuEventRecord");

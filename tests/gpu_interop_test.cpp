@@ -341,6 +341,67 @@ TEST(GpuInterop, HundredFramesWithSemaphoresNoHostWait) {
   c.cu.cuDestroyExternalSemaphore(cu_done);
 }
 
+// A pass that fails after fogcl has waited for "ready" (here: a variant never prepared) still
+// releases the memory and signals "done", so the producer does not wait forever; the frame keeps
+// its unfogged pixels.
+TEST(GpuInterop, AFailingPassStillSignalsDone) {
+  FOGCL_REQUIRE_CUDA_INTEROP();
+  CudaSide& c = cuda_side();
+  const cl_context context = runtime()->context();
+  const cl_device_id device = runtime()->device();
+  vk::ExportableSemaphores vulkan;
+  std::string why;
+  if (!external_support(device).imports_semaphore(ExternalHandle::opaque_fd) || !vulkan.open(c.uuid, why))
+    GTEST_SKIP() << "no semaphore to share: " << (why.empty() ? external_support(device).describe() : why);
+  const int ready = vulkan.create(), done = vulkan.create();
+  const ExternalSemaphore cl_ready = ExternalSemaphore::import_fd(context, device, vulkan.export_fd(ready));
+  const ExternalSemaphore cl_done = ExternalSemaphore::import_fd(context, device, vulkan.export_fd(done));
+  cuda::CUexternalSemaphore cu_ready = nullptr, cu_done = nullptr;
+  cuda::CUDA_EXTERNAL_SEMAPHORE_HANDLE_DESC desc{};
+  desc.type = cuda::CU_EXTERNAL_SEMAPHORE_HANDLE_TYPE_OPAQUE_FD;
+  desc.handle.fd = vulkan.export_fd(ready);
+  CU_OK(c.cu.cuImportExternalSemaphore(&cu_ready, &desc));
+  desc.handle.fd = vulkan.export_fd(done);
+  CU_OK(c.cu.cuImportExternalSemaphore(&cu_done, &desc));
+  const TestFrame t = make_test_frame(320, 180, false, ColorFormat::rgba32f, 7);
+  const std::size_t color_bytes = t.color.size_bytes(), depth_at = (color_bytes + 65535) / 65536 * 65536;
+  cuda::ExportableAllocation alloc;
+  ASSERT_EQ(alloc.create(c.cu, c.device, depth_at + t.depth.size_bytes()), "");
+  CU_OK(c.cu.cuMemcpyHtoD(alloc.ptr, t.color.data(), color_bytes));
+  CU_OK(c.cu.cuMemcpyHtoD(alloc.ptr + depth_at, t.depth.data(), t.depth.size_bytes()));
+  ExternalMemory memory(context, device, alloc.export_fd(), alloc.size);
+  ExternalFrameLayout layout;
+  layout.width = 320;
+  layout.height = 180;
+  layout.color_in = {&memory, 0, 0};
+  layout.depth = {&memory, depth_at, 0};
+  ExternalFrame frame(context, device, layout);
+  FogPass unprepared(context, device);  // its own cache: nothing built
+  cuda::CUstream stream = nullptr;
+  CU_OK(c.cu.cuStreamCreate(&stream, cuda::CU_STREAM_NON_BLOCKING));
+  cuda::CUDA_EXTERNAL_SEMAPHORE_SIGNAL_PARAMS signal{};
+  cuda::CUDA_EXTERNAL_SEMAPHORE_WAIT_PARAMS wait{};
+  CU_OK(c.cu.cuSignalExternalSemaphoresAsync(&cu_ready, &signal, 1, stream));
+  const std::string error = error_of(
+      [&] { frame.enqueue(unprepared, runtime()->queue(), t.params, interop_settings(0.02f), {{&cl_ready}, {&cl_done}, {}}); });
+  EXPECT_NE(error.find("is not prepared"), std::string::npos) << error;
+  CU_OK(c.cu.cuWaitExternalSemaphoresAsync(&cu_done, &wait, 1, stream));
+  cuda::CUresult state = 600;
+  const auto start = std::chrono::steady_clock::now();
+  while ((state = c.cu.cuStreamQuery(stream)) != cuda::CUDA_SUCCESS &&
+         std::chrono::steady_clock::now() - start < std::chrono::seconds(10))
+    usleep(1000);
+  ASSERT_EQ(state, cuda::CUDA_SUCCESS) << "CUDA still waits for \"done\" 10 s after the failed pass";
+  ColorImage back(320, 180, ColorFormat::rgba32f);
+  CU_OK(c.cu.cuMemcpyDtoH(back.data(), alloc.ptr, color_bytes));
+  EXPECT_EQ(std::memcmp(back.data(), t.color.data(), color_bytes), 0) << "the failed frame changed";
+  std::printf("[ info ] failed pass: \"%s\"; \"done\" reached CUDA after %.2f ms\n", error.c_str(),
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  c.cu.cuStreamDestroy(stream);
+  c.cu.cuDestroyExternalSemaphore(cu_ready);
+  c.cu.cuDestroyExternalSemaphore(cu_done);
+}
+
 // The fog volumes on a frame in CUDA's memory, in place, against VolumePass::apply on host images
 // (which culls with the depth image's range, the external frame with none: the same march, up to
 // the variant's culling, hence a budget rather than bits).
