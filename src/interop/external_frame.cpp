@@ -175,26 +175,30 @@ cl_event ExternalFrame::enqueue(cl_command_queue queue_handle, const PassFn& run
             "clEnqueueWaitSemaphoresKHR");
       then(e);
     }
-    check(m.fns->acquire(queue(), cl_uint(m.imported.size()), m.imported.data(), cl_uint(after.size()),
-                         after.empty() ? nullptr : after.data(), &e),
-          "clEnqueueAcquireExternalMemObjectsKHR");
-    then(e);
     // Release and signal: also when the pass throws, so that the renderer never waits forever
     // on a frame that failed (it keeps its unfogged pixels then).
+    bool acquired = false;
     auto finish = [&] {
-      check(m.fns->release(queue(), cl_uint(m.imported.size()), m.imported.data(), cl_uint(after.size()),
-                           after.data(), &e),
-            "clEnqueueReleaseExternalMemObjectsKHR");
-      then(e);
+      if (acquired) {
+        check(m.fns->release(queue(), cl_uint(m.imported.size()), m.imported.data(), cl_uint(after.size()),
+                             after.empty() ? nullptr : after.data(), &e),
+              "clEnqueueReleaseExternalMemObjectsKHR");
+        then(e);
+      }
       if (!signals.empty()) {
         check(m.fns->signal_semaphores(queue(), cl_uint(signals.size()), signals.data(), nullptr,
-                                       cl_uint(after.size()), after.data(), &e),
+                                       cl_uint(after.size()), after.empty() ? nullptr : after.data(), &e),
               "clEnqueueSignalSemaphoresKHR");
         then(e);
       }
       check(clFlush(queue()), "clFlush");
     };
     try {
+      check(m.fns->acquire(queue(), cl_uint(m.imported.size()), m.imported.data(), cl_uint(after.size()),
+                           after.empty() ? nullptr : after.data(), &e),
+            "clEnqueueAcquireExternalMemObjectsKHR");
+      then(e);
+      acquired = true;
       std::vector<cl_event> copies_in;
       for (const Plane* p : {&m.color_in, &m.depth})
         if (p->staged) {
@@ -202,14 +206,17 @@ cl_event ExternalFrame::enqueue(cl_command_queue queue_handle, const PassFn& run
           copies_in.push_back(held.back()());
         }
       if (!copies_in.empty()) after = copies_in;
-      then(run(m.frame, after));
+      const cl_event ran = run(m.frame, after);
+      if (ran == nullptr) throw Error("ExternalFrame::enqueue: the pass returned no event");
+      then(ran);
       const Plane& out = m.in_place ? m.color_in : m.color_out;
       if (out.staged) {
         held.push_back(m.copy(queue, out, false, after));
         after.assign(1, held.back()());
       }
     } catch (...) {
-      after.assign(1, held.back()());
+      after.clear();  // everything enqueued so far
+      for (const cl::Event& h : held) after.push_back(h());
       finish();
       throw;
     }

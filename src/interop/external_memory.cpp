@@ -32,8 +32,11 @@ const KhrFunctions& khr_functions(cl_device_id device) {
   get(f.signal_semaphores, "clEnqueueSignalSemaphoresKHR");
   get(f.semaphore_handle, "clGetSemaphoreHandleForTypeKHR");
   get(f.release_semaphore, "clReleaseSemaphoreKHR");
+  // The loader fogcl is linked with (also when fogcl itself was opened RTLD_LOCAL), else any.
+  void* loader = dlopen("libOpenCL.so.1", RTLD_LAZY | RTLD_NOLOAD);
   f.create_buffer = reinterpret_cast<KhrFunctions::CreateBufferWithProperties>(
-      dlsym(RTLD_DEFAULT, "clCreateBufferWithProperties"));
+      dlsym(loader != nullptr ? loader : RTLD_DEFAULT, "clCreateBufferWithProperties"));
+  if (loader != nullptr) dlclose(loader);  // NOLOAD took a reference to a library that stays loaded
   return by_platform.emplace(platform, f).first->second;
 }
 
