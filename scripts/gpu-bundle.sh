@@ -15,12 +15,14 @@ cd "$root"
 "$here/setup.sh" --bench
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j "$(nproc)" --target fogcl_cli fogcl_tests fogcl_bench fogcl_volume_bench \
-  fogcl_exr_peer fogcl_make_sequence
+  fogcl_exr_peer fogcl_make_sequence fogcl_cuda_interop \
+  fogcl_interop_bench
 
 rm -rf "$bundle"
 mkdir -p "$bundle/bin" "$bundle/lib"
 bins=("$build/src/fogcl" "$build/tests/fogcl_tests" "$build/bench/fogcl_bench" "$build/bench/fogcl_volume_bench"
-      "$build/bench/fogcl_exr_peer" "$build/bench/fogcl_make_sequence")
+      "$build/bench/fogcl_exr_peer" "$build/bench/fogcl_make_sequence" "$build/tests/fogcl_cuda_interop"
+      "$build/bench/fogcl_interop_bench")
 cp "${bins[@]}" "$bundle/bin/"
 strip --strip-debug "$bundle"/bin/*
 
@@ -32,6 +34,11 @@ ldd "${bins[@]}" | awk '/=> \// {print $3}' | sort -u | while read -r lib; do
     *) cp -L "$lib" "$bundle/lib/" ;;
   esac
 done
+# Vulkan's loader and GLVND for the GPU machine, which has NVIDIA's Vulkan driver but not them
+# (gpu-run.sh unpacks them there): the interop tests' semaphores come from Vulkan.
+mkdir -p "$bundle/gl"
+(cd "$bundle/gl" && apt-get -oAPT::Architecture=amd64 download libvulkan1 libglvnd0 libglx0 libgl1 libegl1 \
+  libopengl0 libgles2 >/dev/null 2>&1) || echo "no Vulkan loader in the bundle: the interop semaphore tests will skip"
 cp "$here/gpu-run.sh" "$here/gpu_summary.py" "$root/bench/sequence_bench.py" "$bundle/"
 git rev-parse --short HEAD >"$bundle/COMMIT" 2>/dev/null || echo unknown >"$bundle/COMMIT"
 echo "bundle: $bundle ($(du -sh "$bundle" | cut -f1), commit $(cat "$bundle/COMMIT"))"

@@ -43,6 +43,16 @@ for lib in "$here"/lib/*; do
 done
 export LD_LIBRARY_PATH="$scratch/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 
+# --- Vulkan: its loader and GLVND from the bundle (gl/*.deb) where the machine has none; the
+# interop tests and bench take their shared semaphores from Vulkan (CUDA makes none to export) --
+if ! ldconfig -p | grep -q "libvulkan.so.1 " && ls "$here"/gl/*.deb >/dev/null 2>&1; then
+  for deb in "$here"/gl/*.deb; do dpkg -x "$deb" /; done
+  ldconfig
+fi
+for icd in /usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json /usr/share/vulkan/icd.d/nvidia_icd.json; do
+  [ -e "$icd" ] && { export VK_DRIVER_FILES="$icd"; break; }
+done
+
 {
   echo "commit: $(cat "$here/COMMIT" 2>/dev/null)"
   echo "date: $(date -u +%FT%TZ)"
@@ -68,7 +78,7 @@ if want tests; then
   echo "tests: fogcl_tests with FOGCL_DEVICE=gpu in $shards shards"
   start=$(date +%s)
   for i in $(seq 0 $((shards - 1))); do
-    FOGCL_DEVICE=gpu FOGCL_TEST_CLI="$bin/fogcl" FOGCL_TEST_DIR="$scratch/tests" GTEST_TOTAL_SHARDS=$shards \
+    FOGCL_DEVICE=gpu FOGCL_TEST_CLI="$bin/fogcl" FOGCL_TEST_CUDA_INTEROP="$bin/fogcl_cuda_interop" FOGCL_TEST_DIR="$scratch/tests" GTEST_TOTAL_SHARDS=$shards \
       GTEST_SHARD_INDEX=$i timeout "${GPU_TEST_TIMEOUT:-540}" "$bin/fogcl_tests" \
       --gtest_output="xml:$results/tests-$i.xml" >"$results/tests-$i.log" 2>&1 &
   done
@@ -90,6 +100,8 @@ if want bench; then
   FOGCL_DEVICE=gpu bench fogcl_volume_bench volume-gpu.json 'BM_VolumeDevice|BM_VolumeHostCall|BM_VolumeNothingVisible' \
     --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
   bench fogcl_volume_bench volume-scalar.json 'BM_VolumeScalar'
+  echo "bench: a CUDA producer's frame fogged in its memory, signal to signal"
+  FOGCL_DEVICE=gpu bench fogcl_interop_bench interop-gpu.json 'BM_ExternalSignalToSignal'
 fi
 
 # --- PoCL on every core: the volumetric march from 1 thread to all -----------------------------

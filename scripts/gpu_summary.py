@@ -190,6 +190,41 @@ for b in scalar:
 if scalar:
     p()
 
+# ---- a GPU renderer's frame where it lies ----------------------------------------------------
+inter = load("interop-gpu.json")
+if inter:
+    p("## A CUDA producer's frame fogged in its memory (exp2, in place; median of 200)")
+    p()
+    p("| frame | storage | signal to signal ms | deferred pass ms | beyond the pass µs | target: pass + 50 µs |")
+    p("|---|---|---:|---:|---:|---|")
+    for b in inter:
+        if not b["base"].startswith("BM_ExternalSignalToSignal/"):
+            continue
+        a = args(b["base"])
+        if "error_message" in b or "pass_ms" not in b:
+            p(f'| {a.get("w")}x{a.get("h")} | | skipped: {b.get("error_message", "no figures")} | | | |')
+            continue
+        over = b["over_pass_us"]
+        verdict = "met" if over <= 50 else "FAILED"
+        p(f'| {a["w"]}x{a["h"]} | {"f16" if a["f16"] == "1" else "f32"} | {b["median_ms"]:.4f} | {b["pass_ms"]:.4f} '
+          f'| {over:.1f} | {verdict} |')
+    p()
+    parts = {"0": "CUDA signals and waits alone", "1": "+ OpenCL waits and signals", "2": "+ acquire, release",
+             "3": "+ the deferred pass (ExternalFrame::enqueue)", "4": "no semaphores: the host waits both ways",
+             "5": "OpenCL signals alone", "6": "part 1 on a queue without profiling",
+             "7": "OpenCL waits, then writes a counter CUDA waits for (no OpenCL signal)"}
+    for b in inter:
+        if b["base"].startswith("BM_ExternalHandOverParts/"):
+            part = args(b["base"])["part"]
+            p(f'- hand-over part {part}, {parts.get(part, "?")} (1080p f16): {ms(b) * 1e3:.1f} µs')
+    p()
+    for b in inter:
+        a = args(b["base"])
+        if "over_pass_us" in b and b["over_pass_us"] > 50:
+            p(f'FAILED: {a["w"]}x{a["h"]} f16={a["f16"]}: the hand-over costs {b["over_pass_us"]:.1f} µs beyond the '
+              f'pass (target <= 50)')
+    p()
+
 # ---- host round trips against the bus ----------------------------------------------------------
 # Each convenience call's round trip (BM_OpenCLHostCall in fog-gpu.json, BM_VolumeHostCall in
 # volume-gpu.json) against BM_PinnedTransfer of the same bytes from the deferred run (color and

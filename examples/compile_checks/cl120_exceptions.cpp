@@ -3,6 +3,7 @@
 // warnings included): fogcl must not raise the target version under the integrator's feet.
 #include <CL/opencl.hpp>
 
+#include <fogcl/external_memory.h>
 #include <fogcl/fogcl.h>
 
 #ifndef CL_HPP_ENABLE_EXCEPTIONS

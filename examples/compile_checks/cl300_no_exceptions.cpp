@@ -1,6 +1,7 @@
 // fogcl's public headers under an integrator's own CLHPP settings: OpenCL 3.0 target, CLHPP
 // exceptions off (CMakeLists.txt sets the macros as the project's compile definitions), fogcl
 // included first. Compiled with -Werror: fogcl must neither define nor change any OpenCL macro.
+#include <fogcl/external_memory.h>
 #include <fogcl/fogcl.h>
 #include <fogcl/version.h>
 
