@@ -337,8 +337,9 @@ TEST_F(CliGrammar, VersionNamesTheBuildAndTheDevices) {
     EXPECT_NE(r.output.find("\ncommit: "), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("commit: \n"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("\nOpenCL platforms: "), std::string::npos) << r.output;
-    if (runtime() != nullptr)
+    if (runtime() != nullptr) {
       EXPECT_NE(r.output.find(device_name(runtime()->device())), std::string::npos) << r.output;
+    }
   }
   const std::string empty = fresh_dir("cli-grammar-no-icd");
   const CliRun none = run_cli("--version", "env -u OCL_ICD_FILENAMES OCL_ICD_VENDORS=" + empty);

@@ -5,6 +5,7 @@
 #include "fogcl/camera.h"
 #include "fogcl/depth_kinds.h"
 #include "fogcl/error.h"
+#include "fogcl/external_memory.h"
 #include "fogcl/fog_pass.h"
 #include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
