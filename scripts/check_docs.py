@@ -155,7 +155,8 @@ def check_file_blocks(root, docs):
 
 # Names in docs/library.md that are not C++ of fogcl's: CMake targets, other APIs, words.
 NOT_FOGCL = {"fogcl", "io", "add_subdirectory", "find_package", "target_link_libraries", "InstallAndBuildExamples"}
-OTHER_APIS = ("std::", "cl::", "glm::", "Imath::", "OpenCL::", "CL_", "Unity")
+# Names of the APIs fogcl meets (OpenCL's C types and extensions, Vulkan), not its own.
+OTHER_APIS = ("std::", "cl::", "glm::", "Imath::", "OpenCL::", "CL_", "Unity", "cl_", "Vk", "vk", "VK_")
 
 
 def installed_api(prefix):

@@ -39,7 +39,7 @@ const std::map<std::string, std::map<std::string, FlagSpec>>& flag_table() {
   static const std::map<std::string, std::map<std::string, FlagSpec>> table{
       {"demo",
        {{"--out", {Kind::folder}}, {"--width", {Kind::integer}}, {"--height", {Kind::integer}},
-        {"--device", {Kind::device}}}},
+        {"--device", {Kind::device}}, {"--max-memory", {Kind::size}}}},
       {"report",
        {{"--out", {Kind::folder}}, {"--device", {Kind::device}}, {"--width", {Kind::integer}},
         {"--height", {Kind::integer}}, {"--runs", {Kind::integer}}, {"--volumetric", {Kind::none}},

@@ -8,7 +8,7 @@
 #      output frame byte for byte with one local `fogcl apply` over the whole range; each task's
 #      log must name its frame range;
 #   3. submits the shot again with one task's fogcl SIGKILLed mid-run (its chunk's third input
-#      frame is a FIFO nobody writes, so the task stops there after writing two frames), resubmits
+#      frame's open() is held by a preloaded gate, so the task stops there after writing two frames), resubmits
 #      only that index, and checks the shot complete, byte-identical and free of temporaries.
 # The daemons are stopped by their process ids and the scratch removed on every exit.
 #
@@ -31,8 +31,9 @@ make_sequence=$(readlink -f "$2")
 example=$(readlink -f "$3")
 started=$SECONDS
 TEST_NAME="slurm test" TEST_GATE=FOGCL_SLURM_TEST
+here=$(cd "$(dirname "$0")" && pwd)
 # shellcheck source=tests/support/script_test.sh
-. "$(cd "$(dirname "$0")" && pwd)/../support/script_test.sh"
+. "$here/../support/script_test.sh"
 
 [ "$(id -u)" -eq 0 ] || skip_or_fail "needs root (runs slurmd with SlurmUser root, installs slurm-wlm and munge)"
 
@@ -300,17 +301,17 @@ done
 say "no OpenCL platform (job $job): task 2 on the scalar path, said in its log, frames byte-identical; task 3 past the end: no frames"
 
 # ---- 3. A task that dies mid-run, then only its index again --------------------------------------
-# The same shot into a fresh folder, read through links; task 1's third frame is a FIFO that
-# nobody writes, so its fogcl blocks there after two frames, deterministically.
+# The same shot into a fresh folder, read through links; task 1's third frame is held: its fogcl
+# has open_gate.so preloaded, whose open() of that file never returns, so the task stops there
+# after two frames, deterministically (a FIFO cannot gate it: fogcl refuses one before any frame).
 mkdir gated
 for f in render/*.exr; do ln -s "../$f" "gated/$(basename "$f")"; done
 gate=gated/color.$(printf '%04d' $((FIRST + CHUNK + 2))).exr
-rm "$gate"
-mkfifo "$gate"
+cc -shared -fPIC -O1 -Wall -Werror -o "$PWD/open_gate.so" "$here/open_gate.c" -ldl || fail "cannot build the open gate (cc)"
 export COLOR='gated/color.####.exr' DEPTH='gated/depth.####.exr' OUT='killed/shot.####.exr'
 # Named temporaries, as on NFS, where a killed writer can leave one behind (O_TMPFILE cannot).
 export FOGCL_TEMP_FILES=named
-job=$(submit --array=0-$((tasks - 1)))
+job=$(LD_PRELOAD="$PWD/open_gate.so" FOGCL_GATE_SUFFIX="$gate" submit --array=0-$((tasks - 1)))
 say "submitted job $job into killed/ with task 1 held at $gate"
 victim_first=$((FIRST + CHUNK))
 written=("killed/$(printf 'shot.%04d.exr' "$victim_first")" "killed/$(printf 'shot.%04d.exr' $((victim_first + 1)))")
@@ -340,9 +341,7 @@ present=$(find killed -name 'shot.[0-9]*.exr' | wc -l)
 say "shot incomplete as expected: $present of $((LAST - FIRST + 1)) frames"
 tail -n 3 "fogcl-${job}_1.log" | sed 's/^/  | /'
 
-# The farm's retry: the input is whole again, only index 1 is resubmitted.
-rm "$gate"
-ln -s "../render/$(basename "$gate")" "$gate"
+# The farm's retry, without the gate: only index 1 is resubmitted.
 rerun=$(submit --array=1)
 say "resubmitted: sbatch --array=1 (job $rerun)"
 wait_job "$rerun"
