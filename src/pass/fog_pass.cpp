@@ -121,21 +121,23 @@ cl::Kernel* FogPass::Impl::find_kernel(const Variant& variant) {
 }
 
 void FogPass::prepare(const Variant& variant) {
-  if (!variant.needs_pass() || impl().find_kernel(variant) != nullptr) return;
-  impl().programs->get(impl().device(), "deferred_fog.cl", deferred_fog_cl, build_options_for(variant));
-  impl().find_kernel(variant);
+  Impl& m = impl();
+  if (!variant.needs_pass() || m.find_kernel(variant) != nullptr) return;
+  m.programs->get(m.device(), "deferred_fog.cl", deferred_fog_cl, build_options_for(variant));
+  m.find_kernel(variant);
 }
 
 void FogPass::prepare(const FogSettings& settings, const CameraParams& camera, ColorFormat storage) {
+  impl();
   validate(camera);
   prepare(select_variant(settings, camera, storage));
 }
 
 bool FogPass::is_prepared(const Variant& variant) const {
+  const Impl& m = impl();
   if (!variant.needs_pass()) return true;
   const std::string options = build_options_for(variant);
-  return impl().kernels.count(options) != 0 ||
-         impl().programs->find(impl().device(), "deferred_fog.cl", options) != nullptr;
+  return m.kernels.count(options) != 0 || m.programs->find(m.device(), "deferred_fog.cl", options) != nullptr;
 }
 
 cl_event FogPass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
