@@ -185,9 +185,10 @@ class ColorImage {
   glm::vec4 pixel(int x, int y) const;
   void set_pixel(int x, int y, const glm::vec4& rgba);
 
-  // The image as a view (packed rows); valid while the image lives and is not reassigned.
-  ColorView view() { return ColorView(data(), width_, height_, format_); }
-  ConstColorView view() const { return ConstColorView(data(), width_, height_, format_); }
+  // The image as a view (packed rows; an empty image gives an empty view, which the calls
+  // reject as empty); valid while the image lives and is not reassigned.
+  ColorView view() { return empty() ? ColorView() : ColorView(data(), width_, height_, format_); }
+  ConstColorView view() const { return empty() ? ConstColorView() : ConstColorView(data(), width_, height_, format_); }
   operator ColorView() { return view(); }
   operator ConstColorView() const { return view(); }
 
@@ -219,8 +220,8 @@ class DepthImage {
   float at(int x, int y) const { return data()[index(x, y)]; }
   float& at(int x, int y) { return data()[index(x, y)]; }
 
-  DepthView view() { return DepthView(data(), width_, height_); }
-  ConstDepthView view() const { return ConstDepthView(data(), width_, height_); }
+  DepthView view() { return empty() ? DepthView() : DepthView(data(), width_, height_); }
+  ConstDepthView view() const { return empty() ? ConstDepthView() : ConstDepthView(data(), width_, height_); }
   operator DepthView() { return view(); }
   operator ConstDepthView() const { return view(); }
 
