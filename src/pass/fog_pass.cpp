@@ -149,10 +149,12 @@ cl_event FogPass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb,
   validate(camera, fb.width, fb.height);
   detail::check_wait_list(wait_list, "FogPass::enqueue");
   const Variant v = select_variant(settings, camera, fb.format);
-  return with_cl_errors([&] {
-    const cl::CommandQueue queue = detail::checked_queue(queue_handle, m.context, m.device, "FogPass::enqueue");
-    detail::check_frame_buffers(fb, m.context);
-    return m.dispatch(queue, fb, v, camera, settings, wait_list);
+  return detail::host_call("FogPass::enqueue", [&] {
+    return with_cl_errors([&] {
+      const cl::CommandQueue queue = detail::checked_queue(queue_handle, m.context, m.device, "FogPass::enqueue");
+      detail::check_frame_buffers(fb, m.context);
+      return m.dispatch(queue, fb, v, camera, settings, wait_list);
+    });
   });
 }
 

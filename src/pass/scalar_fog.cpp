@@ -221,9 +221,11 @@ FogResult<T> fog_scalar(const ConstColorView& in, const ConstDepthView& depth, c
   FogResult<T> r;
   r.width = in.width();
   r.height = in.height();
-  r.rgba.resize(4 * in.pixel_count());
-  r.factor.resize(in.pixel_count());
-  r.amount.resize(in.pixel_count());
+  detail::host_call("fog_scalar", [&] {
+    r.rgba.resize(4 * in.pixel_count());
+    r.factor.resize(in.pixel_count());
+    r.amount.resize(in.pixel_count());
+  });
   fog_image<T>(in, depth, cam, v, s, true, 0, in.height(), [&](std::size_t i, int, int, T f, T amount, const T* rgba) {
     r.factor[i] = f;
     r.amount[i] = amount;

@@ -252,12 +252,14 @@ cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& 
                              const std::vector<cl_event>& wait_list, float max_eye) {
   validate(camera, fb.width, fb.height);
   detail::check_wait_list(wait_list, "VolumePass::enqueue");
-  return with_cl_errors([&] {
-    const cl::CommandQueue queue =
-        detail::checked_queue(queue_handle, impl().context, impl().device, "VolumePass::enqueue");
-    std::vector<cl::Event> waits;
-    for (cl_event e : wait_list) waits.push_back(wrap(e));
-    return share(impl().enqueue_frame(queue, fb, camera, scene, requested, shadow, std::move(waits), {}, {}, max_eye));
+  return detail::host_call("VolumePass::enqueue", [&] {
+    return with_cl_errors([&] {
+      const cl::CommandQueue queue =
+          detail::checked_queue(queue_handle, impl().context, impl().device, "VolumePass::enqueue");
+      std::vector<cl::Event> waits;
+      for (cl_event e : wait_list) waits.push_back(wrap(e));
+      return share(impl().enqueue_frame(queue, fb, camera, scene, requested, shadow, std::move(waits), {}, {}, max_eye));
+    });
   });
 }
 

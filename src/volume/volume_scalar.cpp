@@ -14,9 +14,10 @@
 
 namespace fogcl {
 
+namespace {
 template <class T>
-VolumeResult<T> volumes_scalar(const ConstColorView& in, const ConstDepthView& depth_view, const CameraParams& camera,
-                               const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
+VolumeResult<T> volumes_in(const ConstColorView& in, const ConstDepthView& depth_view, const CameraParams& camera,
+                           const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
   using namespace volume_formulas;
   validate_frame(in, depth_view);
   const int w = in.width(), h = in.height();
@@ -73,6 +74,14 @@ VolumeResult<T> volumes_scalar(const ConstColorView& in, const ConstDepthView& d
       for (int c = 0; c < 3; ++c) r.rgba[4 * i + c] = vol_composite(r.rgba[4 * i + c], fog[c], fog.w);
     }
   return r;
+}
+
+}  // namespace
+
+template <class T>
+VolumeResult<T> volumes_scalar(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& camera,
+                               const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
+  return detail::host_call("volumes_scalar", [&] { return volumes_in<T>(in, depth, camera, scene, settings, shadow); });
 }
 
 template VolumeResult<float> volumes_scalar<float>(const ConstColorView&, const ConstDepthView&, const CameraParams&,
