@@ -689,14 +689,14 @@ void BM_HostCallParts(benchmark::State& state) {
   const cl::Device device = wrap(rt->device());
   std::unique_ptr<detail::HostFrame> kept;
   const bool keep = way == 2 || way == 3 || way == 5 || way == 6;
-  if (keep) kept = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+  if (keep) kept = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out, false));
   void *mapped_in = nullptr, *mapped_depth = nullptr, *mapped_out = nullptr;  // way 5
   double create = 0, check = 0, sync = 0, enq = 0, wait = 0, dev = 0, launch = 0, read = 0, release = 0;
   for (auto _ : state) {
     const auto begin = Clock::now();
     auto a = begin;
     std::unique_ptr<detail::HostFrame> fresh;
-    if (!keep) fresh = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out));
+    if (!keep) fresh = std::make_unique<detail::HostFrame>(detail::host_frame(ctx, true, f.color, f.depth, out, false));
     const detail::HostFrame& hf = keep ? *kept : *fresh;
     create += seconds_since(a);
     a = Clock::now();
@@ -795,7 +795,7 @@ void BM_ModeAB(benchmark::State& state) {
   ColorImage out(w, h, format);
   const cl::Context ctx = wrap(rt->context());
   const cl::CommandQueue queue = wrap(rt->queue());
-  const detail::HostFrame hf = detail::host_frame(ctx, true, f.color, f.depth, out);
+  const detail::HostFrame hf = detail::host_frame(ctx, true, f.color, f.depth, out, false);
   std::vector<FogSettings> modes;
   for (int m = 0; m < 3; ++m) {
     FogSettings s;

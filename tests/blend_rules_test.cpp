@@ -11,6 +11,15 @@
 namespace fogcl::test {
 namespace {
 
+// One camera for frames of any shape (probes of a few pixels, 8K frames): the aspect check of
+// the passes is stated off (CameraParams::non_square_pixels).
+template <class Camera>
+CameraParams params_any_frame(const Camera& camera) {
+  CameraParams p = make_camera_params(camera);
+  p.non_square_pixels = true;
+  return p;
+}
+
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr float kMax = std::numeric_limits<float>::max();
@@ -70,7 +79,7 @@ bool same_pixel_bits(const ColorImage& a, const ColorImage& b, int x, int y, int
 TEST_P(BlendRules, FactorOneIsBitExact) {
   // Every pixel is sky (raw depth at the far plane) and the sky is not fogged: f == 1.
   PerspectiveCamera camera;
-  const CameraParams cam = make_camera_params(camera);
+  const CameraParams cam = params_any_frame(camera);
   const ColorImage in = stress_colors();
   const DepthImage depth(in.width(), in.height(), 1.0f);
   FogSettings s;
@@ -84,7 +93,7 @@ TEST_P(BlendRules, FactorOneIsBitExact) {
 TEST_P(BlendRules, FactorZeroIsExactlyFogColor) {
   // density * d ~ 1e20 * 100: exp2's argument squares to +inf; f must be exactly 0, not NaN.
   PerspectiveCamera camera;
-  const CameraParams cam = make_camera_params(camera);
+  const CameraParams cam = params_any_frame(camera);
   const ColorImage in = stress_colors();
   const float raw = float((1000.0 / 100.0 - cam.zbuffer_params.y) / cam.zbuffer_params.x);  // eye depth 100
   const DepthImage depth(in.width(), in.height(), raw);
@@ -117,7 +126,7 @@ TEST_P(BlendRules, FactorZeroIsExactlyFogColor) {
 
 TEST_P(BlendRules, PartialFogKeepsNaNInItsChannelAndFiniteStaysFinite) {
   PerspectiveCamera camera;
-  const CameraParams cam = make_camera_params(camera);
+  const CameraParams cam = params_any_frame(camera);
   const ColorImage in = stress_colors();
   const float raw = float((1000.0 / 100.0 - cam.zbuffer_params.y) / cam.zbuffer_params.x);
   const DepthImage depth(in.width(), in.height(), raw);
@@ -151,7 +160,7 @@ TEST_P(BlendRules, NaNAndOutOfRangeDepth) {
   for (bool reversed : {false, true}) {
     PerspectiveCamera camera;
     camera.reversed_z = reversed;
-    const CameraParams cam = make_camera_params(camera);
+    const CameraParams cam = params_any_frame(camera);
     ColorImage in(4, 1, GetParam().format);
     for (int x = 0; x < 4; ++x) in.set_pixel(x, 0, glm::vec4(1.0f));
     DepthImage depth(4, 1);
@@ -177,7 +186,7 @@ TEST_P(BlendRules, NaNAndOutOfRangeDepth) {
 
 TEST_P(BlendRules, OffAndZeroDensityCopyBitForBit) {
   PerspectiveCamera camera;
-  const CameraParams cam = make_camera_params(camera);
+  const CameraParams cam = params_any_frame(camera);
   const ColorImage in = stress_colors();
   const DepthImage depth(in.width(), in.height(), 0.5f);
   const std::size_t dispatches = GetParam().scalar ? 0 : shared_pass().stats().kernel_dispatches;

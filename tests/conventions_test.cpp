@@ -71,6 +71,7 @@ TEST_P(Conventions, CornerOrderAndUvOrientation) {
                         {"bottom", 1, kBottomLeft, kBottomRight, 2, 3}};
   for (const Side& side : sides) {
     CameraParams cam = base;
+    cam.non_square_pixels = true;  // the frustum is made off-centre and wider on purpose
     cam.frustum_corners[side.a][side.axis] *= 4.0f;
     cam.frustum_corners[side.b][side.axis] *= 4.0f;
     const std::vector<double> d = measured_distance(depth, cam, FogMetric::distance, GetParam());

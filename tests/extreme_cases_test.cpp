@@ -15,6 +15,15 @@
 namespace fogcl::test {
 namespace {
 
+// One camera for frames of any shape (probes of a few pixels, 8K frames): the aspect check of
+// the passes is stated off (CameraParams::non_square_pixels).
+template <class Camera>
+CameraParams params_any_frame(const Camera& camera) {
+  CameraParams p = make_camera_params(camera);
+  p.non_square_pixels = true;
+  return p;
+}
+
 constexpr double kFactorBudget = 2e-6;
 constexpr double kColorRelBudget = 1e-5;
 
@@ -111,7 +120,7 @@ class Extreme : public ::testing::TestWithParam<bool /*scalar*/> {
 
 // 1. start == end: 1 before start, 0 from start on, exactly; no NaN. start > end: an error.
 TEST_P(Extreme, LinearStartEqualsEndIsAHardStep) {
-  const CameraParams cam = make_camera_params(PerspectiveCamera{});
+  const CameraParams cam = params_any_frame(PerspectiveCamera{});
   FogSettings s;
   s.mode = FogMode::linear;
   s.start = s.end = 50.0f;
@@ -142,7 +151,7 @@ TEST_P(Extreme, LinearStartEqualsEndIsAHardStep) {
 TEST_P(Extreme, ZeroDensityIsTheIdentityEvenAtInfinity) {
   PerspectiveCamera pc;
   pc.reversed_z = pc.infinite_far = true;
-  const CameraParams cam = make_camera_params(pc);
+  const CameraParams cam = params_any_frame(pc);
   const TestFrame t = frame_for(cam, 37, 11, ColorFormat::rgba32f, 1e12, 0.3);
   const std::size_t dispatches = scalar() ? 0 : shared_pass().stats().kernel_dispatches;
   for (FogMode m : {FogMode::exp, FogMode::exp2}) {
@@ -160,7 +169,7 @@ TEST_P(Extreme, ZeroDensityIsTheIdentityEvenAtInfinity) {
 
 // 3. density * d of 1e3 and 1e20: f is exactly 0 (the fog color), never NaN after squaring.
 TEST_P(Extreme, HugeOpticalDepthIsExactlyFogColor) {
-  const CameraParams cam = make_camera_params(PerspectiveCamera{});
+  const CameraParams cam = params_any_frame(PerspectiveCamera{});
   const float eye = 100.3f;  // d = 100 (depth-based)
   ColorImage in(2, 1);
   in.set_pixel(0, 0, glm::vec4(1.0f, 2.0f, 3.0f, 0.5f));
@@ -185,7 +194,7 @@ TEST_P(Extreme, HugeOpticalDepthIsExactlyFogColor) {
 // density * d to 1e-6 relative (expm1, not a cancellation).
 TEST_P(Extreme, ThinFogAmountKeepsItsRelativePrecision) {
   if (!scalar()) GTEST_SKIP() << "the fog amount is reported by the scalar path";
-  const CameraParams cam = make_camera_params(PerspectiveCamera{});
+  const CameraParams cam = params_any_frame(PerspectiveCamera{});
   // Eye depths from 10 on: right at the near plane d = L * far - near itself cancels in float.
   const TestFrame t = frame_for(cam, 64, 16, ColorFormat::rgba32f, 900.0, 0.0, 10.0);
   for (FogMode m : {FogMode::exp, FogMode::exp2}) {
@@ -215,7 +224,7 @@ TEST_P(Extreme, HugeFarNearRatio) {
     pc.near_plane = 0.01f;
     pc.far_plane = 1e6f;
     pc.reversed_z = reversed;
-    const CameraParams cam = make_camera_params(pc);
+    const CameraParams cam = params_any_frame(pc);
     ColorImage in(2, 1);
     in.set_pixel(0, 0, glm::vec4(1.0f, 2.0f, 3.0f, 1.0f));
     in.set_pixel(1, 0, glm::vec4(1.0f, 2.0f, 3.0f, 1.0f));
@@ -255,7 +264,7 @@ TEST_P(Extreme, InfiniteFarVariant) {
   PerspectiveCamera pc;
   pc.reversed_z = pc.infinite_far = true;
   pc.aspect = 37.0f / 23.0f;
-  const CameraParams cam = make_camera_params(pc);
+  const CameraParams cam = params_any_frame(pc);
   const TestFrame t = frame_for(cam, 37, 23, ColorFormat::rgba32f, 1e7, 0.2);
   for (FogMetric metric : {FogMetric::depth, FogMetric::distance})
     for (bool skybox : {false, true})
@@ -287,7 +296,7 @@ TEST_P(Extreme, OrthographicVariant) {
     oc.near_plane = 0.5f;
     oc.far_plane = 300.0f;
     oc.reversed_z = reversed;
-    const CameraParams cam = make_camera_params(oc);
+    const CameraParams cam = params_any_frame(oc);
     const TestFrame t = frame_for(cam, 40, 20, ColorFormat::rgba32f, 299.0, 0.1);
     for (const FogSettings& s : every_mode(FogMetric::depth, false)) {
       const Budgets b = check_against_double(scalar(), t, s);
@@ -325,7 +334,7 @@ TEST_P(Extreme, WideFovDistanceIsDepthOverCosine) {
   PerspectiveCamera pc;
   pc.fov_y_deg = 120.0f;
   pc.aspect = 1.0f;
-  const CameraParams cam = make_camera_params(pc);
+  const CameraParams cam = params_any_frame(pc);
   const int n = 33;
   const double eye = 250.0;
   const DepthImage depth(n, n, float(raw_from_eye(cam)(eye)));
@@ -353,7 +362,7 @@ TEST_P(Extreme, OddSizes) {
     for (ColorFormat format : {ColorFormat::rgba32f, ColorFormat::rgba16f}) {
       PerspectiveCamera pc;
       pc.aspect = float(w) / float(h);
-      const CameraParams cam = make_camera_params(pc);
+      const CameraParams cam = params_any_frame(pc);
       const TestFrame t = frame_for(cam, w, h, format, 900.0);
       for (const FogSettings& s : every_mode(FogMetric::distance, false)) {
         const ColorImage out = run(scalar(), t.color, t.depth, cam, s);
@@ -375,7 +384,7 @@ INSTANTIATE_TEST_SUITE_P(KernelAndScalar, Extreme, ::testing::Values(false, true
 TEST(ExtremeSize, EightK) {
   FOGCL_REQUIRE_DEVICE();
   PerspectiveCamera pc;
-  const CameraParams cam = make_camera_params(pc);
+  const CameraParams cam = params_any_frame(pc);
   const TestFrame t = frame_for(cam, 7680, 4320, ColorFormat::rgba16f, 900.0);
   FogSettings s;
   s.mode = FogMode::exp2;

@@ -153,7 +153,9 @@ CameraParams perspective(bool reversed = false, bool infinite = false, float far
   c.far_plane = far;
   c.reversed_z = reversed || infinite;
   c.infinite_far = infinite;
-  return make_camera_params(c);
+  CameraParams p = make_camera_params(c);
+  p.non_square_pixels = true;  // one camera for the tests' frames of every size
+  return p;
 }
 
 CameraParams orthographic(bool reversed = false) {
@@ -161,7 +163,9 @@ CameraParams orthographic(bool reversed = false) {
   c.aspect = 1.5f;
   c.ortho_size = 40.0f;
   c.reversed_z = reversed;
-  return make_camera_params(c);
+  CameraParams p = make_camera_params(c);
+  p.non_square_pixels = true;  // one camera for the tests' frames of every size
+  return p;
 }
 
 FogSettings base_height_settings() {

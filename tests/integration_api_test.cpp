@@ -319,12 +319,14 @@ TEST_F(IntegrationApi, ConvenienceFollowsReusedAndReallocatedImages) {
     const TestFrame a = make_test_frame(97, 61, false, format, 3);
     const TestFrame b = make_test_frame(97, 61, false, format, 11);
     const TestFrame small = make_test_frame(40, 24, false, format, 5);
+    CameraParams params = a.params;
+    params.non_square_pixels = true;  // one camera for both frame sizes
     // The reference: a pass of its own on images of its own.
     const auto fresh = [&](const ColorImage& in, const DepthImage& depth) {
       const ColorImage in_copy = in;
       const DepthImage depth_copy = depth;
       ColorImage out;
-      FogPass(*runtime()).apply(in_copy, depth_copy, out, a.params, settings);
+      FogPass(*runtime()).apply(in_copy, depth_copy, out, params, settings);
       return out;
     };
     const auto same = [](const ColorImage& x, const ColorImage& y) {
@@ -336,7 +338,7 @@ TEST_F(IntegrationApi, ConvenienceFollowsReusedAndReallocatedImages) {
     FogPass pass(*runtime());
     ColorImage in = a.color, out;
     DepthImage depth = a.depth;
-    pass.apply(in, depth, out, a.params, settings);
+    pass.apply(in, depth, out, params, settings);
     EXPECT_TRUE(same(out, fresh(a.color, a.depth))) << "first call";
     const void* in_at = in.data();
     const void* out_at = out.data();
@@ -344,17 +346,17 @@ TEST_F(IntegrationApi, ConvenienceFollowsReusedAndReallocatedImages) {
     // New contents at the same addresses (the same images, written by the caller).
     std::memcpy(in.data(), b.color.data(), in.size_bytes());
     std::memcpy(depth.data(), b.depth.data(), depth.size_bytes());
-    pass.apply(in, depth, out, a.params, settings);
+    pass.apply(in, depth, out, params, settings);
     ASSERT_EQ(in.data(), in_at);
     ASSERT_EQ(out.data(), out_at);
     EXPECT_TRUE(same(out, fresh(b.color, b.depth))) << "same images, new contents";
 
     // The output as the next input (fog applied twice), then in place on the caller's image.
     ColorImage twice;
-    pass.apply(out, depth, twice, a.params, settings);
+    pass.apply(out, depth, twice, params, settings);
     EXPECT_TRUE(same(twice, fresh(fresh(b.color, b.depth), b.depth))) << "output as input";
     ColorImage image = a.color;
-    pass.apply(image, a.depth, image, a.params, settings);
+    pass.apply(image, a.depth, image, params, settings);
     EXPECT_TRUE(same(image, fresh(a.color, a.depth))) << "in place";
 
     // Images freed and allocated again: the allocator often returns the same address and size.
@@ -365,14 +367,14 @@ TEST_F(IntegrationApi, ConvenienceFollowsReusedAndReallocatedImages) {
       depth = DepthImage();
       in = src.color;
       depth = src.depth;
-      pass.apply(in, depth, out, a.params, settings);
+      pass.apply(in, depth, out, params, settings);
       EXPECT_TRUE(same(out, fresh(src.color, src.depth))) << "reallocated, round " << round;
     }
 
     // Another size in between, into the same `out` (apply reallocates it), then back.
-    pass.apply(small.color, small.depth, out, a.params, settings);
+    pass.apply(small.color, small.depth, out, params, settings);
     EXPECT_TRUE(same(out, fresh(small.color, small.depth))) << "smaller frame";
-    pass.apply(a.color, a.depth, out, a.params, settings);
+    pass.apply(a.color, a.depth, out, params, settings);
     EXPECT_TRUE(same(out, fresh(a.color, a.depth))) << "back to the first size";
   }
 }

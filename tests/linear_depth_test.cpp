@@ -27,6 +27,7 @@ CameraParams camera_params(float near_plane, bool reversed, DepthKind kind) {
   c.reversed_z = reversed;
   CameraParams p = make_camera_params(c);
   p.depth_kind = kind;
+  p.non_square_pixels = true;  // one camera for the tests' frames of every size
   return p;
 }
 

@@ -93,6 +93,7 @@ class RendererExr : public ::testing::Test {
     const CliRun r = run_cli("apply " + args + " --out " + out + " --device scalar");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     CameraParams params = make_camera_params(camera);
+    params.non_square_pixels = true;  // as the CLI takes the file's camera: its frustum, whatever the frame
     params.depth_kind = kind;  // linear depth reaches the formulas as it is, in the reference too
     const FogSettings s = fog_settings(distance, skybox);
     const FogResult<double> ref = fog_scalar<double>(color, eye, params, s);

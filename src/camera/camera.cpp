@@ -298,4 +298,23 @@ CameraParams camera_params_from_unity(const UnityCameraConstants& u) {
   validate(p);
   return p;
 }
+double frustum_aspect(const CameraParams& p) {
+  const auto& c = p.frustum_corners;
+  return (double(c[kBottomRight].x) - double(c[kBottomLeft].x)) / (double(c[kTopLeft].y) - double(c[kBottomLeft].y));
+}
+
+void validate(const CameraParams& p, int width, int height) {
+  validate(p);
+  if (p.non_square_pixels || width < 1 || height < 1) return;  // sizes are the frame checks' to report
+  const double camera = frustum_aspect(p), frame = double(width) / double(height);
+  const double tolerance = std::max(1e-3, 0.5 / width + 0.5 / height);
+  if (std::fabs(camera / frame - 1.0) <= tolerance) return;
+  std::string hint;
+  if (std::fabs(camera * frame - 1.0) <= tolerance) hint = " (width and height swapped?)";
+  throw Error("camera aspect " + str(float(camera)) + " does not match the " + std::to_string(width) + "x" +
+              std::to_string(height) + " frame's " + str(float(frame)) + hint +
+              ": make the camera with aspect = width / height, or set CameraParams::non_square_pixels when the "
+              "frustum is meant to differ");
+}
+
 }  // namespace fogcl

@@ -134,7 +134,9 @@ CameraParams frame_params_of(const ApplyOptions& o, const ExrInput& color, std::
     std::snprintf(buf, sizeof buf, "orthographic, size %g (half height), aspect %g, near %g, far %g, %s",
                   camera.ortho_size, camera.aspect, camera.near_plane, camera.far_plane, z);
     *text = buf;
-    return make_camera_params(camera);
+    CameraParams params = make_camera_params(camera);
+    params.non_square_pixels = o.aspect != 0.0f;  // --aspect: a frustum unlike the frame on purpose
+    return params;
   }
   std::string from;
   const PerspectiveCamera camera = frame_camera(o, color, &from);
@@ -145,7 +147,11 @@ CameraParams frame_params_of(const ApplyOptions& o, const ExrInput& color, std::
     std::snprintf(buf, sizeof buf, "perspective, fov %g deg, aspect %g (from %s), near %g, far %g, %s",
                   camera.fov_y_deg, camera.aspect, from.c_str(), camera.near_plane, camera.far_plane, z);
   *text = buf;
-  return make_camera_params(camera);
+  CameraParams params = make_camera_params(camera);
+  // --aspect, or the file's own camera (the projection it was rendered with, whatever its pixels'
+  // shape): the frustum may differ from the frame on purpose. Otherwise the library checks it.
+  params.non_square_pixels = o.aspect != 0.0f || from == "worldToNDC";
+  return params;
 }
 
 // The settings of the pass: the precision from --precision, the error budget (--max-error) or

@@ -7,7 +7,9 @@
 #include "deferred_fog_cl.h"
 #include "fogcl/error.h"
 #include "pass/formulas.h"
+#include "image/packed_frame.h"
 #include "runtime/clhpp.h"
+#include "runtime/host_call.h"
 #include "runtime/frame_buffers.h"
 #include "runtime/host_staging.h"
 #include "runtime/pinned_memory.h"
@@ -35,6 +37,7 @@ struct FogPass::Impl {
   std::shared_ptr<ProgramCache> programs;
   cl::CommandQueue queue;  // convenience queue; created on first apply() if not given
   DeviceTraits traits;
+  std::size_t host_align = 1;  // host memory a CPU device uses in place (frame_buffers.h)
   std::map<std::string, cl::Kernel> kernels;  // by build options
   // The kernel of the most recent variant: a steady stream of frames skips the option string.
   Variant last_kernel_variant;
@@ -46,11 +49,11 @@ struct FogPass::Impl {
   bool staged() const { return transfers.staged(traits.cpu); }
   // apply()'s checks and sizing of `out`; the variant, or nullopt when no device work is needed
   // (then `out` already holds the result).
-  std::optional<Variant> begin_apply(FogPass& pass, const ColorImage& in, const DepthImage& depth, ColorImage& out,
-                                     const CameraParams& camera, const FogSettings& settings);
+  std::optional<Variant> begin_apply(FogPass& pass, const ConstColorView& in, const ConstDepthView& depth,
+                                     const ColorView& out, const CameraParams& camera, const FogSettings& settings);
   // The staged convenience call up to the download's enqueue; `done` is the kernel's event.
-  PendingFrame start_staged(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Variant& v,
-                            const CameraParams& camera, const FogSettings& settings, cl::Event& done);
+  PendingFrame start_staged(detail::PackedFrame views, const Variant& v, const CameraParams& camera,
+                            const FogSettings& settings, cl::Event& done);
   void record_kernel_time(const cl::Event& done);
 
   cl::Kernel* find_kernel(const Variant& variant);
@@ -74,6 +77,7 @@ FogPass::FogPass(cl_context context, cl_device_id device, std::shared_ptr<Progra
     throw Error("FogPass: the shared ProgramCache belongs to another OpenCL context than the pass");
   m.programs = std::move(programs);
   m.traits = device_traits(device, codegen);
+  m.host_align = with_cl_errors([&] { return detail::host_ptr_alignment(m.device); });
 }
 
 FogPass::FogPass(const Runtime& runtime, const CpuCodegen& codegen, std::shared_ptr<ProgramCache> programs)
@@ -81,19 +85,24 @@ FogPass::FogPass(const Runtime& runtime, const CpuCodegen& codegen, std::shared_
   impl_->queue = wrap(runtime.queue());
 }
 
+FogPass::Impl& FogPass::impl() const {
+  if (impl_ == nullptr) throw Error("FogPass used after move: assign a pass to it before calling it again");
+  return *impl_;
+}
+
 FogPass::~FogPass() = default;
 FogPass::FogPass(FogPass&&) noexcept = default;
 FogPass& FogPass::operator=(FogPass&&) noexcept = default;
 
 std::string FogPass::build_options_for(const Variant& variant) const {
-  return build_options(variant, impl_->traits);
+  return build_options(variant, impl().traits);
 }
-const PassStats& FogPass::stats() const { return impl_->stats; }
-const ProgramCache& FogPass::programs() const { return *impl_->programs; }
-const std::shared_ptr<ProgramCache>& FogPass::program_cache() const { return impl_->programs; }
-cl_context FogPass::context() const { return impl_->context(); }
-cl_device_id FogPass::device() const { return impl_->device(); }
-const Variant& FogPass::last_variant() const { return impl_->last_variant; }
+const PassStats& FogPass::stats() const { return impl().stats; }
+const ProgramCache& FogPass::programs() const { return *impl().programs; }
+const std::shared_ptr<ProgramCache>& FogPass::program_cache() const { return impl().programs; }
+cl_context FogPass::context() const { return impl().context(); }
+cl_device_id FogPass::device() const { return impl().device(); }
+const Variant& FogPass::last_variant() const { return impl().last_variant; }
 
 // The kernel of a built variant, or nullptr; creates the kernel object (no build) when another
 // pass sharing the cache built the program.
@@ -112,35 +121,40 @@ cl::Kernel* FogPass::Impl::find_kernel(const Variant& variant) {
 }
 
 void FogPass::prepare(const Variant& variant) {
-  if (!variant.needs_pass() || impl_->find_kernel(variant) != nullptr) return;
-  impl_->programs->get(impl_->device(), "deferred_fog.cl", deferred_fog_cl, build_options_for(variant));
-  impl_->find_kernel(variant);
+  Impl& m = impl();
+  if (!variant.needs_pass() || m.find_kernel(variant) != nullptr) return;
+  m.programs->get(m.device(), "deferred_fog.cl", deferred_fog_cl, build_options_for(variant));
+  m.find_kernel(variant);
 }
 
 void FogPass::prepare(const FogSettings& settings, const CameraParams& camera, ColorFormat storage) {
+  impl();
   validate(camera);
   prepare(select_variant(settings, camera, storage));
 }
 
 bool FogPass::is_prepared(const Variant& variant) const {
+  const Impl& m = impl();
   if (!variant.needs_pass()) return true;
   const std::string options = build_options_for(variant);
-  return impl_->kernels.count(options) != 0 ||
-         impl_->programs->find(impl_->device(), "deferred_fog.cl", options) != nullptr;
+  return m.kernels.count(options) != 0 || m.programs->find(m.device(), "deferred_fog.cl", options) != nullptr;
 }
 
 cl_event FogPass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
                           const FogSettings& settings, const std::vector<cl_event>& wait_list) {
-  Impl& m = *impl_;
+  Impl& m = impl();
   if (fb.width < 1 || fb.height < 1)
     throw Error("frame size must be at least 1x1 (got " + std::to_string(fb.width) + "x" +
                 std::to_string(fb.height) + ")");
-  validate(camera);
+  validate(camera, fb.width, fb.height);
+  detail::check_wait_list(wait_list, "FogPass::enqueue");
   const Variant v = select_variant(settings, camera, fb.format);
-  return with_cl_errors([&] {
-    const cl::CommandQueue queue = detail::checked_queue(queue_handle, m.context, m.device, "FogPass::enqueue");
-    detail::check_frame_buffers(fb, m.context);
-    return m.dispatch(queue, fb, v, camera, settings, wait_list);
+  return detail::host_call("FogPass::enqueue", [&] {
+    return with_cl_errors([&] {
+      const cl::CommandQueue queue = detail::checked_queue(queue_handle, m.context, m.device, "FogPass::enqueue");
+      detail::check_frame_buffers(fb, m.context);
+      return m.dispatch(queue, fb, v, camera, settings, wait_list);
+    });
   });
 }
 
@@ -152,7 +166,7 @@ cl_event FogPass::Impl::dispatch(const cl::CommandQueue& queue, const FrameBuffe
     throw Error("fog variant '" + describe(v) + "' is not prepared: call FogPass::prepare(settings, camera, " +
                 to_string(fb.format) + ") (or prepare(variant)) before enqueue, which never builds a program");
   std::vector<cl::Event> waits_storage;
-  for (cl_event e : wait_list) waits_storage.push_back(wrap(e));
+  for (cl_event e : wait_list) waits_storage.push_back(wrap(e));  // enqueue checked them (null)
   const std::vector<cl::Event>* waits = waits_storage.empty() ? nullptr : &waits_storage;
   cl::Event done;
   last_variant = v;
@@ -222,7 +236,7 @@ const char* to_string(HostTransfer transfer) {
 struct PendingFrame::Impl {
   std::shared_ptr<detail::HostStaging> staging;
   detail::StagedFrame frame;
-  ColorImage* out = nullptr;
+  detail::PackedFrame views;  // out: where the download goes, copied to the caller's view after
 };
 
 namespace {
@@ -249,29 +263,27 @@ PendingFrame& PendingFrame::operator=(PendingFrame&& other) noexcept {
 void PendingFrame::wait() {
   if (impl_ == nullptr) return;
   const std::unique_ptr<Impl> m = std::move(impl_);  // once, also when it throws
-  with_cl_errors([&] { m->staging->finish(m->frame, *m->out); });
+  with_cl_errors([&] { m->staging->finish(m->frame, m->views.out); });
+  m->views.write_back();
 }
 
 bool PendingFrame::done() const { return impl_ == nullptr; }
 
-void FogPass::set_host_transfer(HostTransfer transfer) { impl_->transfers.choice = transfer; }
+void FogPass::set_host_transfer(HostTransfer transfer) { impl().transfers.choice = transfer; }
 HostTransfer FogPass::host_transfer() const {
-  return impl_->staged() ? HostTransfer::staged : HostTransfer::direct;
+  return impl().staged() ? HostTransfer::staged : HostTransfer::direct;
 }
 
-std::optional<Variant> FogPass::Impl::begin_apply(FogPass& pass, const ColorImage& in, const DepthImage& depth,
-                                                  ColorImage& out, const CameraParams& camera,
+std::optional<Variant> FogPass::Impl::begin_apply(FogPass& pass, const ConstColorView& in, const ConstDepthView& depth,
+                                                  const ColorView& out, const CameraParams& camera,
                                                   const FogSettings& settings) {
-  validate_frame(in, depth);
-  validate(camera);
+  validate_frame(in, depth, out);
+  validate(camera, in.width(), in.height());
   const Variant v = select_variant(settings, camera, in.format());
-  const bool in_place = &out == &in;
-  if (!in_place && (out.width() != in.width() || out.height() != in.height() || out.format() != in.format()))
-    out = ColorImage(in.width(), in.height(), in.format());
   stats.last_kernel_ms = 0;
   if (!v.needs_pass()) {  // no device work at all
     last_variant = v;
-    if (!in_place) std::memcpy(out.data(), in.data(), in.size_bytes());
+    if (out.data() != in.data()) detail::copy_pixels(in, out);
     return std::nullopt;
   }
   pass.prepare(v);  // the convenience calls block anyway: the one place that builds on demand
@@ -279,23 +291,20 @@ std::optional<Variant> FogPass::Impl::begin_apply(FogPass& pass, const ColorImag
   return v;
 }
 
-PendingFrame FogPass::Impl::start_staged(const ColorImage& in, const DepthImage& depth, ColorImage& out,
-                                         const Variant& v, const CameraParams& camera, const FogSettings& settings,
-                                         cl::Event& done) {
+PendingFrame FogPass::Impl::start_staged(detail::PackedFrame views, const Variant& v, const CameraParams& camera,
+                                         const FogSettings& settings, cl::Event& done) {
   detail::HostStaging& staging = transfers.staging_of(context, device);
-  detail::StagedFrame frame = staging.start(in, depth, out, [&](const FrameBuffers& fb,
-                                                                const detail::HostStaging::UploadDepth&,
-                                                                const detail::HostStaging::UploadColor& upload_color) {
+  detail::StagedFrame frame = staging.start(views.in, views.depth, views.out,
+                                            [&](const FrameBuffers& fb, const detail::HostStaging::UploadDepth&,
+                                                const detail::HostStaging::UploadColor& upload_color) {
     done = adopt(dispatch(queue, fb, v, camera, settings, {upload_color()()}));
     queue.flush();
     return std::vector<detail::HostStaging::RowsReady>{{fb.height, done}};
   });
   ++stats.copied_frames;
   PendingFrame pending;
-  pending.impl_ = std::make_unique<PendingFrame::Impl>();
-  pending.impl_->staging = transfers.staging;
-  pending.impl_->out = &out;
-  pending.impl_->frame = std::move(frame);
+  pending.impl_ = std::make_unique<PendingFrame::Impl>(
+      PendingFrame::Impl{transfers.staging, std::move(frame), std::move(views)});
   return pending;
 }
 
@@ -310,42 +319,67 @@ void FogPass::Impl::record_kernel_time(const cl::Event& done) {
 
 void FogPass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                     const CameraParams& camera, const FogSettings& settings) {
-  Impl& m = *impl_;
-  const std::optional<Variant> v = m.begin_apply(*this, in, depth, out, camera, settings);
-  if (!v) return;
-  with_cl_errors([&] {
-    cl::Event done;
-    if (m.staged()) {
-      m.start_staged(in, depth, out, *v, camera, settings, done).wait();
-      m.record_kernel_time(done);
-      return;
-    }
-    // CPU devices read and write the host images where they are (page-aligned storage);
-    // other devices get copies.
-    const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
-    // Input, camera and settings were checked above, the buffers are the frame's and the queue
-    // the pass's: no integration-API checks (their getInfo calls were 5-14 us a call).
-    done = adopt(m.dispatch(m.queue, frame.raw, *v, camera, settings, {}));
-    if (detail::read_back(m.queue, m.traits.cpu, frame, done, out))
-      ++m.stats.zero_copy_frames;
-    else
-      ++m.stats.copied_frames;
-    m.record_kernel_time(done);  // read_back waited for it
+  impl();
+  detail::host_call("FogPass::apply", [&] {
+    detail::size_output(in, depth, out, camera);
+    apply(in.view(), depth.view(), out.view(), camera, settings);
+  });
+}
+
+void FogPass::apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                    const CameraParams& camera, const FogSettings& settings) {
+  Impl& m = impl();
+  detail::host_call("FogPass::apply", [&] {
+    const std::optional<Variant> v = m.begin_apply(*this, in, depth, out, camera, settings);
+    if (!v) return;
+    with_cl_errors([&] {
+      cl::Event done;
+      if (m.staged()) {
+        m.start_staged(detail::PackedFrame(in, depth, out, 1), *v, camera, settings, done).wait();
+        m.record_kernel_time(done);
+        return;
+      }
+      // CPU devices read and write the caller's memory where it is (packed rows at the device's
+      // alignment; other memory is copied once); other devices get copies.
+      const detail::PackedFrame views(in, depth, out, m.traits.cpu ? m.host_align : 1);
+      const detail::HostFrame frame =
+          detail::host_frame(m.context, m.traits.cpu, views.in, views.depth, views.out, views.in_place);
+      // Input, camera and settings were checked above, the buffers are the frame's and the queue
+      // the pass's: no integration-API checks (their getInfo calls were 5-14 us a call).
+      done = adopt(m.dispatch(m.queue, frame.raw, *v, camera, settings, {}));
+      if (detail::read_back(m.queue, m.traits.cpu, frame, done, views.out) && !views.copied())
+        ++m.stats.zero_copy_frames;
+      else
+        ++m.stats.copied_frames;
+      views.write_back();
+      m.record_kernel_time(done);  // read_back waited for it
+    });
   });
 }
 
 PendingFrame FogPass::apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                                   const CameraParams& camera, const FogSettings& settings) {
-  Impl& m = *impl_;
+  impl();
+  return detail::host_call("FogPass::apply_async", [&] {
+    detail::size_output(in, depth, out, camera);
+    return apply_async(in.view(), depth.view(), out.view(), camera, settings);
+  });
+}
+
+PendingFrame FogPass::apply_async(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                                  const CameraParams& camera, const FogSettings& settings) {
+  Impl& m = impl();
   if (!m.staged()) {
     apply(in, depth, out, camera, settings);
     return PendingFrame();
   }
-  const std::optional<Variant> v = m.begin_apply(*this, in, depth, out, camera, settings);
-  if (!v) return PendingFrame();
-  return with_cl_errors([&] {
-    cl::Event done;
-    return m.start_staged(in, depth, out, *v, camera, settings, done);
+  return detail::host_call("FogPass::apply_async", [&] {
+    const std::optional<Variant> v = m.begin_apply(*this, in, depth, out, camera, settings);
+    if (!v) return PendingFrame();
+    return with_cl_errors([&] {
+      cl::Event done;
+      return m.start_staged(detail::PackedFrame(in, depth, out, 1), *v, camera, settings, done);
+    });
   });
 }
 

@@ -9,6 +9,7 @@
 #include "fogcl/error.h"
 #include "fogcl/variant.h"
 #include "pass/formulas.h"
+#include "runtime/host_call.h"
 #include "settings/fog_coefficients.h"
 
 // The user-facing float path is compiled twice, for CPUs with FMA and for the x86-64 baseline,
@@ -46,7 +47,7 @@ float load_channel(const std::uint16_t* p) {
 // with the fog factor, the fog amount 1 - f (only if with_amount, else 0) and the blended color
 // (alpha passed through), all in T.
 template <class T, class Channel, class Sink>
-FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, const CameraParams& cam,
+FOGCL_INLINE void fog_pixels(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& cam,
                 const Variant& v, const FogSettings& s, bool with_amount, int y0, int y1, Sink&& sink) {
   using namespace detail;
   using namespace formulas;
@@ -56,7 +57,6 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
   const T near_plane = T(cam.near_plane()), far_plane = T(cam.far_plane());
   const T fog[3] = {T(s.color.r), T(s.color.g), T(s.color.b)};
   const auto cn = fog_ray_corners(cam);
-  const float* raw_depth = depth.data();
   const int mode = int(v.mode), distance = v.distance, skybox = v.fog_skybox, reversed = v.reversed_z;
   const int projection = int(v.projection), squared = FOG_SQUARED(mode, distance);
   const int kind = int(v.depth_kind), sky_infinite = v.sky_infinite;
@@ -79,6 +79,8 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
   }
   for (int y = y0; y < y1; ++y) {
     const T vv = fog_pixel_v(T(y), T(h));
+    const auto* color = reinterpret_cast<const Channel*>(in.row(y));  // rows may be padded (views)
+    const float* raw_depth = depth.row(y);
     for (int x = 0; x < w; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
       if (height) {
@@ -86,11 +88,11 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
         fog_corner_ray(cn, fog_pixel_u(T(x), inv_width), vv, ray);
         int sky;
         T wy, d0, q_sun;
-        const T s_hit = fog_height_geometry(T(raw_depth[i]), ray[0], ray[1], ray[2], kind, reversed, projection, zx, zy,
+        const T s_hit = fog_height_geometry(T(raw_depth[x]), ray[0], ray[1], ray[2], kind, reversed, projection, zx, zy,
                                             near_plane, far_plane, hc.up[0], hc.up[1], hc.up[2], hc.light[0],
                                             hc.light[1], hc.light[2], (features & FOG_HF_SUN) != 0, hc.d0, &sky, &wy,
                                             &d0, &q_sun);
-        const Channel* c = color + 4 * i;
+        const Channel* c = color + 4 * x;
         T rgba[4] = {T(load_channel(c)), T(load_channel(c + 1)), T(load_channel(c + 2)), T(load_channel(c + 3))};
         const int fogged = fog_height_pixel(rgba, s_hit, sky, wy, d0, q_sun, hc.p, features);
         T f = 1, amount = 0;
@@ -103,114 +105,128 @@ FOGCL_INLINE void fog_pixels(const Channel* color, const DepthImage& depth, cons
         } else if (fogged) {
           f = T(0.5);  // not 1: the pixel changed (the half path copies the bits where f == 1)
         }
-        sink(i, f, amount, rgba);
+        sink(i, x, y, f, amount, rgba);
         continue;
       }
       const T ray = needs_ray ? fog_corner_ray_term(cn, fog_pixel_u(T(x), inv_width), vv, ray_squared) : T(0);
       T f = 1, amount = 0;
       if (v.needs_pass()) {
         int sky;
-        const T q = fog_view_distance(T(raw_depth[i]), ray, kind, distance, reversed, projection, squared, zx,
+        const T q = fog_view_distance(T(raw_depth[x]), ray, kind, distance, reversed, projection, squared, zx,
                                       zy, near_plane, far_plane, &sky);
         f = fog_factor_at(q, sky, mode, squared, skybox, sky_infinite, k.a, k.b);
         if (with_amount) amount = fog_amount_at(q, sky, mode, squared, skybox, sky_infinite, k.a, k.b);
       }
-      const Channel* c = color + 4 * i;
+      const Channel* c = color + 4 * x;
       T rgba[4];
       for (int ch = 0; ch < 3; ++ch) rgba[ch] = fog_blend(T(load_channel(c + ch)), fog[ch], f);
       rgba[3] = T(load_channel(c + 3));
-      sink(i, f, amount, rgba);
+      sink(i, x, y, f, amount, rgba);
     }
   }
 }
 
 // Runs fog_pixels with the channel type of the image's storage.
 template <class T, class Sink>
-FOGCL_INLINE void fog_image(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+FOGCL_INLINE void fog_image(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& cam,
                const Variant& v, const FogSettings& s, bool with_amount, int y0, int y1, Sink&& sink) {
   if (in.format() == ColorFormat::rgba32f)
-    fog_pixels<T>(in.rgba32f(), depth, cam, v, s, with_amount, y0, y1, sink);
+    fog_pixels<T, float>(in, depth, cam, v, s, with_amount, y0, y1, sink);
   else
-    fog_pixels<T>(in.rgba16f(), depth, cam, v, s, with_amount, y0, y1, sink);
+    fog_pixels<T, std::uint16_t>(in, depth, cam, v, s, with_amount, y0, y1, sink);
 }
 
-Variant checked_variant(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+Variant checked_variant(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& cam,
                         const FogSettings& s) {
   validate_frame(in, depth);
-  validate(cam);
+  validate(cam, in.width(), in.height());
   return select_variant(s, cam, in.format());
 }
 
 // The float path of apply_fog_scalar (see FOGCL_TARGET_CLONES).
-FOGCL_TARGET_CLONES void fog_into(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
-                                  const Variant& v, const FogSettings& s, ColorImage& out, int y0, int y1) {
+FOGCL_TARGET_CLONES void fog_into(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& cam,
+                                  const Variant& v, const FogSettings& s, const ColorView& out, int y0, int y1) {
   const std::size_t pixel_bytes = bytes_per_pixel(in.format());
-  const auto* src = static_cast<const std::byte*>(in.data());
-  auto* dst = static_cast<std::byte*>(out.data());
   if (in.format() == ColorFormat::rgba32f) {
-    float* o = out.rgba32f();
-    fog_image<float>(in, depth, cam, v, s, false, y0, y1, [&](std::size_t i, float, float, const float* rgba) {
-      for (int c = 0; c < 4; ++c) o[4 * i + c] = rgba[c];
-    });
+    fog_image<float>(in, depth, cam, v, s, false, y0, y1,
+                     [&](std::size_t, int x, int y, float, float, const float* rgba) {
+                       float* o = reinterpret_cast<float*>(out.row(y)) + 4 * x;
+                       for (int c = 0; c < 4; ++c) o[c] = rgba[c];
+                     });
   } else {
-    std::uint16_t* o = out.rgba16f();
-    fog_image<float>(in, depth, cam, v, s, false, y0, y1, [&](std::size_t i, float f, float, const float* rgba) {
-      if (f == 1.0f) {  // keep the bits: a half -> float -> half trip would quiet a signalling NaN
-        std::memcpy(dst + i * pixel_bytes, src + i * pixel_bytes, pixel_bytes);
-        return;
-      }
-      for (int c = 0; c < 3; ++c) o[4 * i + c] = Imath::half(rgba[c]).bits();
-      o[4 * i + 3] = in.rgba16f()[4 * i + 3];
-    });
+    fog_image<float>(in, depth, cam, v, s, false, y0, y1,
+                     [&](std::size_t, int x, int y, float f, float, const float* rgba) {
+                       const std::byte* src = in.row(y) + std::size_t(x) * pixel_bytes;
+                       std::byte* dst = out.row(y) + std::size_t(x) * pixel_bytes;
+                       if (f == 1.0f) {  // keep the bits: a half -> float -> half trip would quiet a signalling NaN
+                         std::memmove(dst, src, pixel_bytes);  // in place: the same pixel
+                         return;
+                       }
+                       auto* o = reinterpret_cast<std::uint16_t*>(dst);
+                       const std::uint16_t alpha = reinterpret_cast<const std::uint16_t*>(src)[3];
+                       for (int c = 0; c < 3; ++c) o[c] = Imath::half(rgba[c]).bits();
+                       o[3] = alpha;
+                     });
   }
+}
+
+// Rows [y0, y1) of `in` into `out` as they are (fog off), unless out is in.
+void copy_rows(const ConstColorView& in, const ColorView& out, int y0, int y1) {
+  if (out.data() == in.data()) return;
+  for (int y = y0; y < y1; ++y) std::memcpy(out.row(y), in.row(y), in.row_bytes());
 }
 
 }  // namespace
 
 void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                       const CameraParams& cam, const FogSettings& s) {
+  detail::host_call("apply_fog_scalar", [&] {
+    detail::size_output(in, depth, out, cam);
+    apply_fog_scalar(in.view(), depth.view(), out.view(), cam, s);
+  });
+}
+
+void apply_fog_scalar(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                      const CameraParams& cam, const FogSettings& s) {
   const Variant v = checked_variant(in, depth, cam, s);
-  if (&out != &in && (out.width() != in.width() || out.height() != in.height() ||
-                      out.format() != in.format()))
-    out = ColorImage(in.width(), in.height(), in.format());
+  validate_frame(in, depth, out);
   if (!v.needs_pass()) {
-    if (&out != &in) std::memcpy(out.data(), in.data(), in.size_bytes());
+    copy_rows(in, out, 0, in.height());
     return;
   }
   fog_into(in, depth, cam, v, s, out, 0, in.height());
 }
 
-void apply_fog_scalar_rows(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& cam,
-                           const FogSettings& s, int first_row, int end_row) {
+void apply_fog_scalar_rows(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                           const CameraParams& cam, const FogSettings& s, int first_row, int end_row) {
   const Variant v = checked_variant(in, depth, cam, s);
   if (out.width() != in.width() || out.height() != in.height() || out.format() != in.format())
     throw Error("apply_fog_scalar_rows: the output must have the input's size and format (" +
                 std::to_string(in.width()) + "x" + std::to_string(in.height()) + " " + to_string(in.format()) + ")");
+  validate_frame(in, depth, out);
   if (first_row < 0 || end_row > in.height() || first_row > end_row)
     throw Error("apply_fog_scalar_rows: rows [" + std::to_string(first_row) + ", " + std::to_string(end_row) +
                 ") are not inside [0, " + std::to_string(in.height()) + ")");
   if (!v.needs_pass()) {
-    const std::size_t row_bytes = std::size_t(in.width()) * bytes_per_pixel(in.format());
-    if (&out != &in)
-      std::memcpy(static_cast<std::byte*>(out.data()) + std::size_t(first_row) * row_bytes,
-                  static_cast<const std::byte*>(in.data()) + std::size_t(first_row) * row_bytes,
-                  std::size_t(end_row - first_row) * row_bytes);
+    copy_rows(in, out, first_row, end_row);
     return;
   }
   fog_into(in, depth, cam, v, s, out, first_row, end_row);
 }
 
 template <class T>
-FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& cam,
+FogResult<T> fog_scalar(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& cam,
                         const FogSettings& s) {
   const Variant v = checked_variant(in, depth, cam, s);
   FogResult<T> r;
   r.width = in.width();
   r.height = in.height();
-  r.rgba.resize(4 * in.pixel_count());
-  r.factor.resize(in.pixel_count());
-  r.amount.resize(in.pixel_count());
-  fog_image<T>(in, depth, cam, v, s, true, 0, in.height(), [&](std::size_t i, T f, T amount, const T* rgba) {
+  detail::host_call("fog_scalar", [&] {
+    r.rgba.resize(4 * in.pixel_count());
+    r.factor.resize(in.pixel_count());
+    r.amount.resize(in.pixel_count());
+  });
+  fog_image<T>(in, depth, cam, v, s, true, 0, in.height(), [&](std::size_t i, int, int, T f, T amount, const T* rgba) {
     r.factor[i] = f;
     r.amount[i] = amount;
     for (int c = 0; c < 4; ++c) r.rgba[4 * i + c] = rgba[c];
@@ -218,7 +234,7 @@ FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const Cam
   return r;
 }
 
-double max_abs_rgb_error(const ColorImage& image, const FogResult<double>& reference) {
+double max_abs_rgb_error(const ConstColorView& image, const FogResult<double>& reference) {
   double worst = 0;
   for (int y = 0; y < image.height(); ++y)
     for (int x = 0; x < image.width(); ++x) {
@@ -232,7 +248,7 @@ double max_abs_rgb_error(const ColorImage& image, const FogResult<double>& refer
   return worst;
 }
 
-double max_abs_factor_error(const ColorImage& probe, const FogResult<double>& reference) {
+double max_abs_factor_error(const ConstColorView& probe, const FogResult<double>& reference) {
   double worst = 0;
   for (int y = 0; y < probe.height(); ++y)
     for (int x = 0; x < probe.width(); ++x) {
@@ -246,9 +262,9 @@ double max_abs_factor_error(const ColorImage& probe, const FogResult<double>& re
   return worst;
 }
 
-template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,
+template FogResult<float> fog_scalar<float>(const ConstColorView&, const ConstDepthView&, const CameraParams&,
                                             const FogSettings&);
-template FogResult<double> fog_scalar<double>(const ColorImage&, const DepthImage&,
+template FogResult<double> fog_scalar<double>(const ConstColorView&, const ConstDepthView&,
                                               const CameraParams&, const FogSettings&);
 
 }  // namespace fogcl

@@ -1,5 +1,7 @@
 #include "runtime/frame_buffers.h"
 
+#include <algorithm>
+
 namespace fogcl::detail {
 
 namespace {
@@ -46,19 +48,20 @@ cl::CommandQueue checked_queue(cl_command_queue handle, const cl::Context& conte
   return queue;
 }
 
-HostFrame host_frame(const cl::Context& ctx, bool cpu, const ColorImage& in, const DepthImage& depth,
-                     ColorImage& out) {
+HostFrame host_frame(const cl::Context& ctx, bool cpu, const ConstColorView& in, const ConstDepthView& depth,
+                     const ColorView& out, bool in_place) {
   const cl_mem_flags host = cpu ? CL_MEM_USE_HOST_PTR : CL_MEM_COPY_HOST_PTR;
   void* in_ptr = const_cast<void*>(in.data());
+  const std::size_t color_bytes = in.span_bytes();
   HostFrame f;
-  f.depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, depth.size_bytes(), const_cast<float*>(depth.data()));
-  if (&out == &in) {
-    f.color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | host, in.size_bytes(), in_ptr);
+  f.depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, depth.span_bytes(), const_cast<float*>(depth.data()));
+  if (in_place) {
+    f.color_in = cl::Buffer(ctx, CL_MEM_READ_WRITE | host, color_bytes, in_ptr);
     f.color_out = f.color_in;
   } else {
-    f.color_in = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, in.size_bytes(), in_ptr);
-    f.color_out = cpu ? cl::Buffer(ctx, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, out.size_bytes(), out.data())
-                      : cl::Buffer(ctx, CL_MEM_WRITE_ONLY, out.size_bytes());
+    f.color_in = cl::Buffer(ctx, CL_MEM_READ_ONLY | host, color_bytes, in_ptr);
+    f.color_out = cpu ? cl::Buffer(ctx, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, color_bytes, out.data())
+                      : cl::Buffer(ctx, CL_MEM_WRITE_ONLY, color_bytes);
   }
   f.raw.width = in.width();
   f.raw.height = in.height();
@@ -69,7 +72,8 @@ HostFrame host_frame(const cl::Context& ctx, bool cpu, const ColorImage& in, con
   return f;
 }
 
-bool read_back(const cl::CommandQueue& queue, bool cpu, const HostFrame& f, const cl::Event& done, ColorImage& out) {
+bool read_back(const cl::CommandQueue& queue, bool cpu, const HostFrame& f, const cl::Event& done,
+               const ColorView& out) {
   const std::vector<cl::Event> after{done};
   if (cpu) {
     // Mapping is what makes a USE_HOST_PTR buffer's contents valid in host memory (the spec: the
@@ -81,13 +85,20 @@ bool read_back(const cl::CommandQueue& queue, bool cpu, const HostFrame& f, cons
     // buffers are released after the finish, so `out` keeps the mapped bits. clEnqueueReadBuffer
     // into the host_ptr itself (also defined for USE_HOST_PTR) would be one command, but PoCL
     // copies the buffer onto itself then (way 3: +0.35 ms at 1080p).
-    void* mapped = queue.enqueueMapBuffer(f.color_out, CL_FALSE, CL_MAP_READ, 0, out.size_bytes(), &after);
+    void* mapped = queue.enqueueMapBuffer(f.color_out, CL_FALSE, CL_MAP_READ, 0, out.span_bytes(), &after);
     queue.enqueueUnmapMemObject(f.color_out, mapped);
     queue.finish();
     return true;
   }
-  queue.enqueueReadBuffer(f.color_out, CL_TRUE, 0, out.size_bytes(), out.data(), &after);
+  queue.enqueueReadBuffer(f.color_out, CL_TRUE, 0, out.span_bytes(), out.data(), &after);
   return false;
+}
+
+std::size_t host_ptr_alignment(const cl::Device& device) {
+  // The spec's rule for a buffer's base address, in bits. PoCL takes host memory at this alignment
+  // in place and copies memory that is not (docs/library.md#images-and-views).
+  const cl_uint bits = device.getInfo<CL_DEVICE_MEM_BASE_ADDR_ALIGN>();
+  return std::max<std::size_t>(bits / 8, 1);
 }
 
 }  // namespace fogcl::detail

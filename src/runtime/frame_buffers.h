@@ -24,11 +24,16 @@ struct HostFrame {
   cl::Buffer color_in, depth, color_out;
   FrameBuffers raw;
 };
-// out must already have in's size and format; color_out is color_in when &out == &in.
-HostFrame host_frame(const cl::Context& context, bool cpu, const ColorImage& in, const DepthImage& depth,
-                     ColorImage& out);
+// Packed views (image/packed_frame.h), out of in's size and format; color_out is color_in when
+// in_place. On a CPU device their memory must be at host_ptr_alignment().
+HostFrame host_frame(const cl::Context& context, bool cpu, const ConstColorView& in, const ConstDepthView& depth,
+                     const ColorView& out, bool in_place);
 // Blocks until `out` holds color_out after `done`. Returns true when nothing was copied (a CPU
 // device maps the host memory the kernel wrote).
-bool read_back(const cl::CommandQueue& queue, bool cpu, const HostFrame& frame, const cl::Event& done, ColorImage& out);
+bool read_back(const cl::CommandQueue& queue, bool cpu, const HostFrame& frame, const cl::Event& done,
+               const ColorView& out);
+// The alignment [bytes] at which the device takes host memory as it is (CL_MEM_USE_HOST_PTR
+// without a copy): CL_DEVICE_MEM_BASE_ADDR_ALIGN in bytes.
+std::size_t host_ptr_alignment(const cl::Device& device);
 
 }  // namespace fogcl::detail

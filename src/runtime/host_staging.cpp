@@ -478,7 +478,8 @@ std::vector<cl::Event> HostStaging::rows_events(const std::vector<RowsReady>& re
   return events;
 }
 
-StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes) {
+StagedFrame HostStaging::start(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                    const Passes& passes) {
   StagedFrame frame;
   frame.owner_ = this;
   frame.slot_ = &take_slot(in.width(), in.height(), in.format());
@@ -518,7 +519,7 @@ StagedFrame HostStaging::start(const ColorImage& in, const DepthImage& depth, Co
   return frame;
 }
 
-void HostStaging::download(StagedFrame& frame, const std::vector<RowsReady>& ready, ColorImage& out) {
+void HostStaging::download(StagedFrame& frame, const std::vector<RowsReady>& ready, const ColorView& out) {
   StagingSlot& s = *frame.slot_;
   if (ready.empty() || ready.back().rows_end != s.height)
     throw Error("HostStaging: the passes' rows do not end at the frame's last row");
@@ -543,7 +544,7 @@ void HostStaging::download(StagedFrame& frame, const std::vector<RowsReady>& rea
   download_queue_.flush();
 }
 
-void HostStaging::finish(StagedFrame& frame, ColorImage& out) {
+void HostStaging::finish(StagedFrame& frame, const ColorView& out) {
   if (!frame) return;
   StagingSlot& s = *frame.slot_;
   if (s.downloads.empty()) throw Error("HostStaging::finish: the frame's download was never enqueued");

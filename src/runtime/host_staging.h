@@ -119,8 +119,8 @@ class HostStaging {
   HostStaging& operator=(const HostStaging&) = delete;
 
   // A convenience call's round trip up to the result's download, with no host wait: in and depth
-  // (same size) go up through a free slot's pinned memory, the depth first, its copies begun
-  // before passes is called.
+  // (same size, packed rows: image/packed_frame.h) go up through a free slot's pinned memory, the
+  // depth first, its copies begun before passes is called.
   // passes(buffers, upload_depth, upload_color) enqueues the passes on the slot's device buffers:
   // it does what needs neither image meanwhile, calls upload_depth(rows), which waits for the
   // copies of the depth's rows [0, rows) (the rest go on) and returns when which rows of it are
@@ -148,16 +148,17 @@ class HostStaging {
   // The events after which rows [0, rows) of `ready` are there: its entries up to the first that
   // reaches `rows` (all of them past the last).
   static std::vector<cl::Event> rows_events(const std::vector<RowsReady>& ready, int rows);
-  StagedFrame start(const ColorImage& in, const DepthImage& depth, ColorImage& out, const Passes& passes);
+  StagedFrame start(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                    const Passes& passes);
   // Threads for work on a frame's host images before start() (the upload's, idle until then; a
   // batch of another frame's upload is waited for): the volume pass's culling scan of the depth.
   CopyWorkers& scan_workers() { return up_workers_; }
   // Waits for the download and copies it into `out` (the image given to start()); then the slot
   // is free for the next frame. Thread-safe against start() of other frames.
-  void finish(StagedFrame& frame, ColorImage& out);
+  void finish(StagedFrame& frame, const ColorView& out);
 
  private:
-  void download(StagedFrame& frame, const std::vector<RowsReady>& ready, ColorImage& out);
+  void download(StagedFrame& frame, const std::vector<RowsReady>& ready, const ColorView& out);
   friend class StagedFrame;
   void give_back(StagingSlot* slot);
   void unmap(StagingSlot& slot);

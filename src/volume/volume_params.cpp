@@ -19,6 +19,7 @@
 #include "camera/camera_basis.h"
 #include "fogcl/error.h"
 #include "fogcl/volume_pass.h"
+#include "image/packed_frame.h"
 #include "runtime/format.h"
 #include "runtime/host_staging.h"
 #include "volume/volume_formulas.h"
@@ -247,13 +248,14 @@ void value_range(const float* values, std::size_t n, float& lo, float& hi, bool&
 }
 }  // namespace
 
-float max_eye_depth(const DepthImage& depth, const CameraParams& camera) {
-  return detail::max_eye_depth(depth, camera, nullptr);
+float max_eye_depth(const ConstDepthView& depth, const CameraParams& camera) {
+  DepthImage copy;
+  return detail::max_eye_depth(detail::packed_depth(depth, copy), camera, nullptr);
 }
 
 namespace detail {
 
-float max_eye_depth(const DepthImage& depth, const CameraParams& camera, CopyWorkers* workers) {
+float max_eye_depth(const ConstDepthView& depth, const CameraParams& camera, CopyWorkers* workers) {
   validate(camera);
   // Eye depth is monotonic in the stored value for every depth kind (a clamp, then a linear or
   // reciprocal map; NaN goes to the far end) but for the jumps to +inf (sky, nothing written) at

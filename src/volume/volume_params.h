@@ -45,7 +45,7 @@ class CopyWorkers;
 
 // fogcl::max_eye_depth, the chunks of the scan spread over `workers`' threads where given (the
 // same float: tests/volume_culling_test.cpp).
-float max_eye_depth(const DepthImage& depth, const CameraParams& camera, CopyWorkers* workers);
+float max_eye_depth(const ConstDepthView& depth, const CameraParams& camera, CopyWorkers* workers);  // packed rows
 
 // Validates everything and packs the frame (culling with max_eye_depth). Throws fogcl::Error.
 // NoiseSampling::automatic packs as buffer (the host paths' filtering): a pass resolves it for its

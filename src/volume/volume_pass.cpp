@@ -5,7 +5,9 @@
 #include <tuple>
 
 #include "fogcl/error.h"
+#include "image/packed_frame.h"
 #include "runtime/clhpp.h"
+#include "runtime/host_call.h"
 #include "runtime/frame_buffers.h"
 #include "runtime/host_staging.h"
 #include "runtime/work_groups.h"
@@ -47,6 +49,7 @@ struct VolumePass::Impl {
   std::shared_ptr<ProgramCache> programs;
   cl::CommandQueue queue;  // convenience queue
   DeviceTraits traits;
+  std::size_t host_align = 1;  // host memory a CPU device uses in place (frame_buffers.h)
   bool images = false;     // the device supports images
   NoiseSamplingDevice noise_device;  // what NoiseSampling::automatic resolves from
   struct KernelEntry {
@@ -80,6 +83,10 @@ struct VolumePass::Impl {
                         std::vector<cl::Event>& writes);
   detail::ConvenienceTransfers transfers;
   bool staged() const { return transfers.staged(traits.cpu); }
+  // The convenience call over views (VolumePass::apply).
+  void apply(VolumePass& pass, const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+             const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
+             const ShadowMap* shadow);
 
   // The kernel of a built program, or nullptr (never builds; creates the kernel object when
   // another pass sharing the cache built the program). private_bytes: the host's bound of a work-item's
@@ -151,6 +158,7 @@ VolumePass::VolumePass(cl_context context, cl_device_id device, std::shared_ptr<
     throw Error("VolumePass: the shared ProgramCache belongs to another OpenCL context than the pass");
   m.programs = std::move(programs);
   m.traits = device_traits(device, codegen);
+  m.host_align = with_cl_errors([&] { return detail::host_ptr_alignment(m.device); });
   m.images = with_cl_errors([&] { return m.device.getInfo<CL_DEVICE_IMAGE_SUPPORT>() == CL_TRUE; });
   m.noise_device.cpu = m.traits.cpu;
   m.noise_device.images = m.images;
@@ -169,17 +177,22 @@ VolumePass::VolumePass(const Runtime& runtime, std::shared_ptr<ProgramCache> pro
   impl_->queue = wrap(runtime.queue());
 }
 
+VolumePass::Impl& VolumePass::impl() const {
+  if (impl_ == nullptr) throw Error("VolumePass used after move: assign a pass to it before calling it again");
+  return *impl_;
+}
+
 VolumePass::~VolumePass() = default;
 VolumePass::VolumePass(VolumePass&&) noexcept = default;
 VolumePass& VolumePass::operator=(VolumePass&&) noexcept = default;
 
-const VolumePassStats& VolumePass::stats() const { return impl_->stats; }
-const ProgramCache& VolumePass::programs() const { return *impl_->programs; }
-const std::shared_ptr<ProgramCache>& VolumePass::program_cache() const { return impl_->programs; }
-const std::string& VolumePass::last_march_options() const { return impl_->last_march_options; }
-const std::string& VolumePass::last_composite_options() const { return impl_->last_composite_options; }
+const VolumePassStats& VolumePass::stats() const { return impl().stats; }
+const ProgramCache& VolumePass::programs() const { return *impl().programs; }
+const std::shared_ptr<ProgramCache>& VolumePass::program_cache() const { return impl().programs; }
+const std::string& VolumePass::last_march_options() const { return impl().last_march_options; }
+const std::string& VolumePass::last_composite_options() const { return impl().last_composite_options; }
 NoiseSampling VolumePass::noise_sampling(NoiseSampling requested) const {
-  return resolve_noise_sampling(requested, impl_->noise_device);
+  return resolve_noise_sampling(requested, impl().noise_device);
 }
 
 const cl::Memory& VolumePass::Impl::noise_on_device(const cl::CommandQueue& q, const VolumeSettings& settings,
@@ -220,7 +233,7 @@ const cl::Memory& VolumePass::Impl::noise_on_device(const cl::CommandQueue& q, c
 
 void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& requested,
                          ColorFormat storage, const ShadowMapParams* shadow) {
-  Impl& m = *impl_;
+  Impl& m = impl();
   const VolumeSettings settings = m.resolved(requested);
   if (settings.noise_sampling == NoiseSampling::image && !m.images)
     throw Error("noise sampling 'image' needs a device with image support; " + device_name(m.device()) +
@@ -237,12 +250,16 @@ void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, c
 cl_event VolumePass::enqueue(cl_command_queue queue_handle, const FrameBuffers& fb, const CameraParams& camera,
                              const VolumeScene& scene, const VolumeSettings& requested, const ShadowMapBuffer* shadow,
                              const std::vector<cl_event>& wait_list, float max_eye) {
-  return with_cl_errors([&] {
-    const cl::CommandQueue queue =
-        detail::checked_queue(queue_handle, impl_->context, impl_->device, "VolumePass::enqueue");
-    std::vector<cl::Event> waits;
-    for (cl_event e : wait_list) waits.push_back(wrap(e));
-    return share(impl_->enqueue_frame(queue, fb, camera, scene, requested, shadow, std::move(waits), {}, {}, max_eye));
+  validate(camera, fb.width, fb.height);
+  detail::check_wait_list(wait_list, "VolumePass::enqueue");
+  return detail::host_call("VolumePass::enqueue", [&] {
+    return with_cl_errors([&] {
+      const cl::CommandQueue queue =
+          detail::checked_queue(queue_handle, impl().context, impl().device, "VolumePass::enqueue");
+      std::vector<cl::Event> waits;
+      for (cl_event e : wait_list) waits.push_back(wrap(e));
+      return share(impl().enqueue_frame(queue, fb, camera, scene, requested, shadow, std::move(waits), {}, {}, max_eye));
+    });
   });
 }
 
@@ -423,22 +440,40 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   return done;
 }
 
-void VolumePass::set_host_transfer(HostTransfer transfer) { impl_->transfers.choice = transfer; }
+void VolumePass::set_host_transfer(HostTransfer transfer) { impl().transfers.choice = transfer; }
 HostTransfer VolumePass::host_transfer() const {
-  return impl_->staged() ? HostTransfer::staged : HostTransfer::direct;
+  return impl().staged() ? HostTransfer::staged : HostTransfer::direct;
 }
 
 void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
                        const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
-  Impl& m = *impl_;
-  validate_frame(in, depth);
+  impl();
+  detail::host_call("VolumePass::apply", [&] {
+    detail::size_output(in, depth, out, camera);
+    apply(in.view(), depth.view(), out.view(), camera, scene, settings, shadow);
+  });
+}
+
+void VolumePass::apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                       const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
+                       const ShadowMap* shadow) {
+  Impl& m = impl();
+  detail::host_call("VolumePass::apply", [&] { m.apply(*this, in, depth, out, camera, scene, settings, shadow); });
+}
+
+void VolumePass::Impl::apply(VolumePass& pass, const ConstColorView& in, const ConstDepthView& depth,
+                             const ColorView& out, const CameraParams& camera, const VolumeScene& scene,
+                             const VolumeSettings& settings, const ShadowMap* shadow) {
+  Impl& m = *this;
+  validate_frame(in, depth, out);
+  validate(camera, in.width(), in.height());
+  const bool in_place = out.data() == in.data();
   // Pinned staging (runtime/host_staging.h), the GPU default. There the culling scan is on the
   // critical path of the round trip: the staging's threads share it.
   detail::HostStaging* staging = m.staged() ? &m.transfers.staging_of(m.context, m.device) : nullptr;
-  const float max_eye = detail::max_eye_depth(depth, camera, staging ? &staging->scan_workers() : nullptr);
-  const bool in_place = &out == &in;
-  if (!in_place && (out.width() != in.width() || out.height() != in.height() || out.format() != in.format()))
-    out = ColorImage(in.width(), in.height(), in.format());
+  // Views the kernels can take: packed rows, on CPU devices at the device's alignment.
+  detail::PackedFrame views(in, depth, out, m.traits.cpu && staging == nullptr ? m.host_align : 1);
+  const float max_eye = detail::max_eye_depth(views.depth, camera, staging ? &staging->scan_workers() : nullptr);
   // Culling first: a frame without visible volumes touches no device at all.
   const detail::PackedVolumeFrame f = detail::pack_volume_frame(
       in.width(), in.height(), camera, scene, settings, in.format(), shadow ? &shadow->params : nullptr,
@@ -448,10 +483,10 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
     m.stats.volumes_culled += scene.volumes.size();
     m.last_march_options.clear();
     m.last_composite_options.clear();
-    if (!in_place) std::memcpy(out.data(), in.data(), in.size_bytes());
+    if (!in_place) detail::copy_pixels(in, out);
     return;
   }
-  prepare(camera, scene, settings, in.format(), shadow ? &shadow->params : nullptr);  // apply blocks anyway
+  pass.prepare(camera, scene, settings, in.format(), shadow ? &shadow->params : nullptr);  // apply blocks anyway
   with_cl_errors([&] {
     if (m.queue() == nullptr) m.queue = cl::CommandQueue(m.context, m.device, CL_QUEUE_PROFILING_ENABLE);
     ShadowMapBuffer sm;
@@ -466,7 +501,7 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
     }
     if (staging != nullptr) {
       detail::StagedFrame staged = staging->start(
-          in, depth, out,
+          views.in, views.depth, views.out,
           [&](const FrameBuffers& fb, const detail::HostStaging::UploadDepth& upload_depth,
               const detail::HostStaging::UploadColor& upload_color) {
             // The march reads the depth only: it runs while the color is sent up.
@@ -476,12 +511,19 @@ void VolumePass::apply(const ColorImage& in, const DepthImage& depth, ColorImage
             m.queue.flush();
             return rows;
           });
-      staging->finish(staged, out);
-      return;
+      staging->finish(staged, views.out);
+      ++m.stats.copied_frames;
+    } else {
+      const detail::HostFrame frame =
+          detail::host_frame(m.context, m.traits.cpu, views.in, views.depth, views.out, views.in_place);
+      const cl::Event done = adopt(pass.enqueue(m.queue(), frame.raw, camera, scene, settings, shadow ? &sm : nullptr,
+                                                {}, max_eye));
+      if (detail::read_back(m.queue, m.traits.cpu, frame, done, views.out) && !views.copied())
+        ++m.stats.zero_copy_frames;
+      else
+        ++m.stats.copied_frames;
     }
-    const detail::HostFrame frame = detail::host_frame(m.context, m.traits.cpu, in, depth, out);
-    const cl::Event done = adopt(enqueue(m.queue(), frame.raw, camera, scene, settings, shadow ? &sm : nullptr, {}, max_eye));
-    detail::read_back(m.queue, m.traits.cpu, frame, done, out);
+    views.write_back();
   });
 }
 

@@ -7,17 +7,23 @@
 
 #include "fogcl/error.h"
 #include "fogcl/volume_pass.h"
+#include "image/packed_frame.h"
+#include "runtime/host_call.h"
 #include "volume/volume_formulas.h"
 #include "volume/volume_params.h"
 
 namespace fogcl {
 
+namespace {
 template <class T>
-VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& camera,
-                               const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
+VolumeResult<T> volumes_in(const ConstColorView& in, const ConstDepthView& depth_view, const CameraParams& camera,
+                           const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
   using namespace volume_formulas;
-  validate_frame(in, depth);
+  validate_frame(in, depth_view);
   const int w = in.width(), h = in.height();
+  validate(camera, w, h);
+  DepthImage depth_copy;  // the march reads packed rows: padded ones are copied once
+  const ConstDepthView depth = detail::packed_depth(depth_view, depth_copy);
   const detail::PackedVolumeFrame f = detail::pack_volume_frame(
       w, h, camera, scene, settings, in.format(), shadow ? &shadow->params : nullptr,
       shadow ? shadow->depth.width() : 0, shadow ? shadow->depth.height() : 0, max_eye_depth(depth, camera));
@@ -70,32 +76,49 @@ VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, co
   return r;
 }
 
-template VolumeResult<float> volumes_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,
+}  // namespace
+
+template <class T>
+VolumeResult<T> volumes_scalar(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& camera,
+                               const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
+  return detail::host_call("volumes_scalar", [&] { return volumes_in<T>(in, depth, camera, scene, settings, shadow); });
+}
+
+template VolumeResult<float> volumes_scalar<float>(const ConstColorView&, const ConstDepthView&, const CameraParams&,
                                                    const VolumeScene&, const VolumeSettings&, const ShadowMap*);
-template VolumeResult<double> volumes_scalar<double>(const ColorImage&, const DepthImage&, const CameraParams&,
+template VolumeResult<double> volumes_scalar<double>(const ConstColorView&, const ConstDepthView&, const CameraParams&,
                                                      const VolumeScene&, const VolumeSettings&, const ShadowMap*);
 
 void apply_volumes_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
                           const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow) {
+  detail::host_call("apply_volumes_scalar", [&] {
+    detail::size_output(in, depth, out, camera);
+    apply_volumes_scalar(in.view(), depth.view(), out.view(), camera, scene, settings, shadow);
+  });
+}
+
+void apply_volumes_scalar(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                          const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
+                          const ShadowMap* shadow) {
+  validate_frame(in, depth, out);
   const VolumeResult<float> r = volumes_scalar<float>(in, depth, camera, scene, settings, shadow);
-  ColorImage result = in;  // A == 0 pixels and alpha keep their bits
+  detail::copy_pixels(in, out);  // A == 0 pixels and alpha keep their bits (nothing when in place)
   for (int y = 0; y < in.height(); ++y)
     for (int x = 0; x < in.width(); ++x) {
       const std::size_t i = std::size_t(y) * in.width() + x;
       if (r.coverage[i] == 0.0f) continue;
       const glm::vec4 o(r.rgba[4 * i], r.rgba[4 * i + 1], r.rgba[4 * i + 2], 0.0f);
       if (in.format() == ColorFormat::rgba16f) {
-        std::uint16_t* p = result.rgba16f() + 4 * i;
+        auto* p = reinterpret_cast<std::uint16_t*>(out.row(y)) + 4 * x;
         for (int k = 0; k < 3; ++k) p[k] = Imath::half(o[k]).bits();
       } else {
-        float* p = result.rgba32f() + 4 * i;
+        auto* p = reinterpret_cast<float*>(out.row(y)) + 4 * x;
         for (int k = 0; k < 3; ++k) p[k] = o[k];
       }
     }
-  out = std::move(result);
 }
 
-double max_abs_rgb_error(const ColorImage& image, const VolumeResult<double>& ref) {
+double max_abs_rgb_error(const ConstColorView& image, const VolumeResult<double>& ref) {
   if (image.width() != ref.width || image.height() != ref.height)
     throw Error("max_abs_rgb_error: image and reference sizes differ");
   double worst = 0.0;

@@ -80,6 +80,11 @@ struct CameraParams {
   // in world space, the deferred pass's height fog (FogMode::height, docs/DESIGN.md §6) among
   // them; the other modes ignore it. The volume pass takes its pose from VolumeScene::pose.
   std::optional<CameraPose> pose;
+  // The frustum's aspect (corner width / height) differs from the frame's width / height on
+  // purpose (non-square pixels, an anamorphic squeeze): the passes then skip that check
+  // (validate(params, width, height)). Default false: a mismatch, such as a 16:9 camera on a
+  // square frame or width and height swapped, is an error.
+  bool non_square_pixels = false;
 
   float near_plane() const { return projection_params.y; }
   float far_plane() const { return projection_params.z; }
@@ -123,6 +128,13 @@ namespace fogcl {
 //    order BL, TL, TR, BR fails this), not a rectangle, or not at the far plane (z = far;
 //    infinite far: z = 1).
 void validate(const CameraParams& params);
+// The same, and the frame the constants are used on: unless params.non_square_pixels, the
+// frustum's aspect (the corners' width / height) must be the frame's width / height within the
+// larger of relative 1e-3 and half a pixel of each side's rounding (0.5 / width + 0.5 / height
+// relative), else fogcl::Error naming both aspects. Every pass checks this for each frame.
+void validate(const CameraParams& params, int width, int height);
+// The frustum's aspect: the corner rays' width over their height.
+double frustum_aspect(const CameraParams& params);
 
 // The constants as a Unity renderer has them, under Unity's names.
 struct UnityCameraConstants {

@@ -90,6 +90,7 @@ class PendingFrame {
   std::unique_ptr<Impl> impl_;
 };
 
+// A pass that was moved from throws fogcl::Error ("FogPass used after move") from every call.
 // Threads: a FogPass is not thread-safe (its kernels carry arguments between setArg and the
 // enqueue): use one per thread, or lock around it. Passes on any threads may share one
 // ProgramCache, which is thread-safe. Handles passed in are borrowed for the call, except the
@@ -123,8 +124,9 @@ class FogPass {
   // (clReleaseEvent). Never blocks the host and never builds: a variant that is not prepared
   // (see is_prepared) throws fogcl::Error naming it; call prepare() first. Fog off (or density
   // 0) enqueues no kernel: a marker when color_out is color_in, else one buffer copy.
-  // Throws fogcl::Error for invalid input (camera, settings, buffers of the wrong size or
-  // context), fogcl::ClError for OpenCL failures; nothing is enqueued then.
+  // Throws fogcl::Error for invalid input (camera, settings, a camera whose aspect is not the
+  // frame's: validate(camera, width, height), buffers of the wrong size or context, a null event
+  // in wait_list), fogcl::ClError for OpenCL failures; nothing is enqueued then.
   cl_event enqueue(cl_command_queue queue, const FrameBuffers& frame, const CameraParams& camera,
                    const FogSettings& settings, const std::vector<cl_event>& wait_list = {});
 
@@ -134,6 +136,13 @@ class FogPass {
   // the kernel (CL_MEM_USE_HOST_PTR), nothing is copied.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out,
              const CameraParams& camera, const FogSettings& settings);
+  // The same over the caller's memory (views, image.h): out must have in's size and format (a
+  // view is not resized) and is either in itself (in place) or memory apart from in and depth.
+  // On CPU devices the kernel works in that memory when its rows are packed and it starts at the
+  // device's CL_DEVICE_MEM_BASE_ADDR_ALIGN; otherwise each image is copied once (stats():
+  // zero_copy_frames or copied_frames). docs/library.md#images-and-views.
+  void apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+             const CameraParams& camera, const FogSettings& settings);
   // apply() that returns once `in` and `depth` are no longer needed, before `out` holds the
   // result (staged transfers: the upload, kernel and download are queued; the next call's upload
   // overlaps this one's download). `out` is sized here and must stay alive and untouched until
@@ -141,6 +150,9 @@ class FogPass {
   // flight is kept; more get staging of their own, up to 16 in flight, then this throws
   // fogcl::Error. With direct transfers it is apply() and returns a finished frame.
   PendingFrame apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+                           const CameraParams& camera, const FogSettings& settings);
+  // The same over views (as apply); `out`'s memory must stay alive until wait().
+  PendingFrame apply_async(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
                            const CameraParams& camera, const FogSettings& settings);
 
   // The convenience calls' transfers (default automatic); the choice in effect for this device.
@@ -160,6 +172,7 @@ class FogPass {
 
  private:
   struct Impl;
+  Impl& impl() const;  // throws when moved from
   std::unique_ptr<Impl> impl_;
 };
 

@@ -17,11 +17,15 @@ namespace fogcl {
 // Throws fogcl::Error for invalid settings, camera constants or mismatched/empty images.
 void apply_fog_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                       const CameraParams& camera, const FogSettings& settings);
+// The same over the caller's memory (views, image.h; any row stride): out must have in's size
+// and format and be in itself or memory apart from in and depth.
+void apply_fog_scalar(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                      const CameraParams& camera, const FogSettings& settings);
 
 // apply_fog_scalar on rows [first_row, end_row) of the frame only, for callers that spread a frame
 // over their own threads: every pixel gets the bits apply_fog_scalar gives it, rows outside the
 // range are not touched. `out` must already have in's size and format (else fogcl::Error).
-void apply_fog_scalar_rows(const ColorImage& in, const DepthImage& depth, ColorImage& out,
+void apply_fog_scalar_rows(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
                            const CameraParams& camera, const FogSettings& settings, int first_row, int end_row);
 
 // The fog evaluated in T (float or double), unrounded to the storage format: rgba has
@@ -39,20 +43,20 @@ struct FogResult {
 };
 
 template <class T>
-FogResult<T> fog_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& camera,
+FogResult<T> fog_scalar(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& camera,
                         const FogSettings& settings);
 
 // max over pixels and R, G, B of |image - reference.rgba| (a NaN difference counts as +inf):
 // the "max error against the float64 path" every tool of the project reports.
-double max_abs_rgb_error(const ColorImage& image, const FogResult<double>& reference);
+double max_abs_rgb_error(const ConstColorView& image, const FogResult<double>& reference);
 
 // The same for the fog factor, from a probe run (color (1, 1, 1, 1), fog color 0: every output
 // channel is f): max |probe RGB - reference.factor|.
-double max_abs_factor_error(const ColorImage& probe, const FogResult<double>& reference);
+double max_abs_factor_error(const ConstColorView& probe, const FogResult<double>& reference);
 
-extern template FogResult<float> fog_scalar<float>(const ColorImage&, const DepthImage&,
+extern template FogResult<float> fog_scalar<float>(const ConstColorView&, const ConstDepthView&,
                                                    const CameraParams&, const FogSettings&);
-extern template FogResult<double> fog_scalar<double>(const ColorImage&, const DepthImage&,
+extern template FogResult<double> fog_scalar<double>(const ConstColorView&, const ConstDepthView&,
                                                      const CameraParams&, const FogSettings&);
 
 }  // namespace fogcl

@@ -32,6 +32,8 @@ struct VolumePassStats {
   std::size_t frames_without_volumes = 0;  // frames where nothing was visible: no dispatch
   std::size_t noise_uploads = 0;           // noise textures uploaded to the device
   std::size_t volumes_culled = 0;          // volumes left out by the host-side culling, all frames
+  std::size_t zero_copy_frames = 0;        // convenience frames run on host memory in place
+  std::size_t copied_frames = 0;           // convenience frames copied to and from the device
 };
 
 // The volumes of `scene` a frame can see, in the order given: each sphere is tested against the
@@ -43,8 +45,9 @@ std::vector<std::size_t> visible_volumes(const VolumeScene& scene, const CameraP
                                          float max_eye_depth = INFINITY);
 
 // The farthest eye depth of a depth buffer, +inf when any pixel is sky (docs/DESIGN.md §2's test).
-float max_eye_depth(const DepthImage& depth, const CameraParams& camera);
+float max_eye_depth(const ConstDepthView& depth, const CameraParams& camera);
 
+// A pass that was moved from throws fogcl::Error ("VolumePass used after move") from every call.
 // Threads: a VolumePass is not thread-safe (kernel arguments, noise uploads): one per thread, or
 // lock around it. Passes may share one ProgramCache (thread-safe) with each other and with
 // FogPasses. It keeps its noise textures on the device across frames, and up to four frames'
@@ -78,7 +81,8 @@ class VolumePass {
   // Never blocks and never builds (an unprepared variant throws fogcl::Error saying so). color_out
   // may be color_in (in place). Nothing visible (culling with max_eye_depth, see visible_volumes):
   // no kernel, a marker when in place, else one buffer copy — the output is the input bit for
-  // bit. A noise texture's first frame enqueues its upload. shadow may be null.
+  // bit. A noise texture's first frame enqueues its upload. shadow may be null. The camera's
+  // aspect must be the frame's (validate(camera, width, height)); a null event in wait_list throws.
   cl_event enqueue(cl_command_queue queue, const FrameBuffers& frame, const CameraParams& camera,
                    const VolumeScene& scene, const VolumeSettings& settings,
                    const ShadowMapBuffer* shadow = nullptr, const std::vector<cl_event>& wait_list = {},
@@ -88,6 +92,11 @@ class VolumePass {
   // result. out is reallocated unless it has in's size and format; out may be in. Culls with the
   // depth image's range: nothing visible touches no device.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
+             const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow = nullptr);
+  // The same over the caller's memory (views, image.h), as FogPass::apply's views: out has in's
+  // size and format and is in itself or apart from in and depth; on CPU devices memory with packed
+  // rows at the device's alignment is used in place, other memory is copied once.
+  void apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out, const CameraParams& camera,
              const VolumeScene& scene, const VolumeSettings& settings, const ShadowMap* shadow = nullptr);
   // The convenience call's transfers (FogPass's HostTransfer; default automatic: direct on CPU
   // devices, pinned staging elsewhere); the choice in effect for this device.
@@ -106,6 +115,7 @@ class VolumePass {
 
  private:
   struct Impl;
+  Impl& impl() const;  // throws when moved from
   std::unique_ptr<Impl> impl_;
 };
 

@@ -25,7 +25,7 @@ struct VolumeResult {
 // The whole pass in T: culling (with the depth image's range), the march at the settings'
 // resolution, the upsampling and the composite. Nothing visible: rgba is the input.
 template <class T>
-VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, const CameraParams& camera,
+VolumeResult<T> volumes_scalar(const ConstColorView& in, const ConstDepthView& depth, const CameraParams& camera,
                                const VolumeScene& scene, const VolumeSettings& settings,
                                const ShadowMap* shadow = nullptr);
 
@@ -34,14 +34,20 @@ VolumeResult<T> volumes_scalar(const ColorImage& in, const DepthImage& depth, co
 void apply_volumes_scalar(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                           const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
                           const ShadowMap* shadow = nullptr);
+// The same over the caller's memory (views, image.h; any row stride): out must have in's size and
+// format and be in itself or memory apart from in and depth.
+void apply_volumes_scalar(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                          const CameraParams& camera, const VolumeScene& scene, const VolumeSettings& settings,
+                          const ShadowMap* shadow = nullptr);
 
 // max over pixels and R, G, B of |image - reference.rgba| (NaN differences count as +inf).
-double max_abs_rgb_error(const ColorImage& image, const VolumeResult<double>& reference);
+double max_abs_rgb_error(const ConstColorView& image, const VolumeResult<double>& reference);
 
-extern template VolumeResult<float> volumes_scalar<float>(const ColorImage&, const DepthImage&, const CameraParams&,
-                                                          const VolumeScene&, const VolumeSettings&, const ShadowMap*);
-extern template VolumeResult<double> volumes_scalar<double>(const ColorImage&, const DepthImage&, const CameraParams&,
-                                                            const VolumeScene&, const VolumeSettings&,
-                                                            const ShadowMap*);
+extern template VolumeResult<float> volumes_scalar<float>(const ConstColorView&, const ConstDepthView&,
+                                                          const CameraParams&, const VolumeScene&,
+                                                          const VolumeSettings&, const ShadowMap*);
+extern template VolumeResult<double> volumes_scalar<double>(const ConstColorView&, const ConstDepthView&,
+                                                            const CameraParams&, const VolumeScene&,
+                                                            const VolumeSettings&, const ShadowMap*);
 
 }  // namespace fogcl
