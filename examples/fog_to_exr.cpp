@@ -16,7 +16,9 @@ int main(int argc, char** argv) try {
   }
   const std::string dir = argv[1];
   const int width = 64, height = 48;
-  const fogcl::CameraParams camera = fogcl::make_camera_params(fogcl::PerspectiveCamera{});  // Unity's
+  fogcl::PerspectiveCamera lens;  // Unity's defaults, with the frame's aspect
+  lens.aspect = float(width) / float(height);
+  const fogcl::CameraParams camera = fogcl::make_camera_params(lens);
   fogcl::ColorImage color(width, height);
   fogcl::DepthImage depth(width, height);
   for (int y = 0; y < height; ++y)

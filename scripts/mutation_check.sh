@@ -64,7 +64,7 @@ mutants=(
   "exp2 coefficient 1/sqrt(ln 2) x 1.0001|src/settings/fog_coefficients.h|s/kInvSqrtLn2 = 1.20112240878644803896;/kInvSqrtLn2 = 1.20124252102732668376;/"
   "height fog's G(a) x 1.0001|kernels/fog_math.h|s/(FOG_REAL)1 : fmax(q, (FOG_REAL)0x1p-126f));/(FOG_REAL)1 : fmax(q, (FOG_REAL)0x1p-126f) * (FOG_REAL)1.0001f);/"
   "blend: fog color x 1.0001 in the mix|kernels/fog_math.h|s/return fma(f, c - fog_color, fog_color);/return fma(f, c - fog_color, fog_color * (FOG_REAL)1.0001f);/"
-  "linear: start x 1.0001 in 1 / (end - start)|src/settings/fog_coefficients.h|s#c.b = T(1) / (T(s.end) - T(s.start));#c.b = T(1) / (T(s.end) - T(s.start) * T(1.0001));#"
+  "linear: start x 1.0001 in 1 / (end - start)|src/settings/fog_coefficients.h|s#c.b = finite(T(1) / (T(s.end) - T(s.start)));#c.b = finite(T(1) / (T(s.end) - T(s.start) * T(1.0001)));#"
   "height fog's in-scattering J = 1 - T x 1.0001|kernels/fog_math.h|s/\*j = -\*j;/*j = -*j * (FOG_REAL)1.0001f;/"
   "stylized volumes: alpha's density x 1.0001|kernels/volume_integrate.h|s/vol_saturate(vol_saturate(accumulation \/ marched) \* VOL_P(vol, VOL_V_DENSITY))/vol_saturate(vol_saturate(accumulation \/ marched) * VOL_P(vol, VOL_V_DENSITY) * (VOL_REAL)1.0001f)/"
   "stylized volumes: the seed's blend keeps 1.0001 x (1 - a)|kernels/volume_integrate.h|s/const VOL_REAL keep = (VOL_REAL)1 - c.w;/const VOL_REAL keep = ((VOL_REAL)1 - c.w) * (VOL_REAL)1.0001f;/"

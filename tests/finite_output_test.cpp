@@ -110,6 +110,7 @@ CameraParams draw_camera(const Shape& shape, Rng& rng) {
     p = make_camera_params(c);
   }
   p.depth_kind = shape.kind;
+  p.non_square_pixels = true;  // the aspect is drawn apart from the frame's on purpose: any frustum
   // The pose: heights from usual to 1e30; directions at random, straight up or down, or level.
   CameraPose pose;
   const double r = unit(rng);

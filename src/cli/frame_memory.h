@@ -105,6 +105,8 @@ auto naming_allocations(const std::string& what, const std::string& hint, Fn&& f
     return fn();
   } catch (const std::bad_alloc&) {
     throw Error("out of memory " + what + (hint.empty() ? std::string() : " (" + hint + ")"));
+  } catch (const OutOfMemory& e) {  // the library's, naming the buffer
+    throw Error("out of memory " + what + " (" + e.what() + (hint.empty() ? std::string() : "; " + hint) + ")");
   }
 }
 // The hint for a frame's buffers: the machine had less free memory than the limit allows.

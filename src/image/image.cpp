@@ -42,7 +42,7 @@ detail::AlignedBytes image_storage(const std::string& what, std::size_t bytes) {
   try {
     return detail::AlignedBytes(bytes);
   } catch (const std::bad_alloc&) {
-    throw Error(what + ": cannot allocate " + std::to_string(bytes) + " bytes (out of host memory)");
+    throw OutOfMemory(what + ": cannot allocate " + std::to_string(bytes) + " bytes (out of host memory)");
   }
 }
 

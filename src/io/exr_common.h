@@ -84,7 +84,7 @@ auto with_read_errors(const std::string& path, Read&& read) -> decltype(read()) 
   } catch (const Error&) {
     throw;
   } catch (const std::bad_alloc&) {
-    throw Error(path + ": cannot read EXR: out of memory");
+    throw OutOfMemory(path + ": cannot read EXR: out of memory");
   } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
     throw Error(path + ": cannot read EXR: " + one_line(e.what()));
   } catch (...) {

@@ -24,7 +24,7 @@ auto host_call(const char* who, Fn&& fn) -> decltype(fn()) {
   } catch (const Error&) {
     throw;
   } catch (const std::bad_alloc&) {
-    throw Error(std::string(who) + ": out of host memory (an allocation for the frame failed)");
+    throw OutOfMemory(std::string(who) + ": out of host memory (an allocation for the frame failed)");
   } catch (const std::exception& e) {
     throw Error(std::string(who) + ": " + e.what());
   }

@@ -1,4 +1,4 @@
-// Error types. Every failure the library reports is one of these two; messages name the value
+// Error types. Every failure the library reports is one of these; messages name the value
 // that was wrong and the rule it broke, or the OpenCL call and its error name.
 #pragma once
 
@@ -12,6 +12,13 @@ namespace fogcl {
 class Error : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+// Host memory for a frame could not be allocated; what() names what was being allocated and its
+// size, e.g. "color image 8192x8192 rgba32f: cannot allocate 1073741824 bytes (out of host memory)".
+class OutOfMemory : public Error {
+ public:
+  using Error::Error;
 };
 
 // An OpenCL call failed. what() reads e.g. "clBuildProgram failed: CL_BUILD_PROGRAM_FAILURE (-11)"
