@@ -8,9 +8,9 @@
  *                      "handled SIGNO" each time one of the program's signal handlers has returned.
  *                      With it set, the program's handlers (sigaction) run wrapped so that the
  *                      gate sees them.
- *   FOGCL_GATE_RELEASE the number of handled signals after which the held call proceeds (from
- *                      within the handler's effects: the handler has returned first). Unset or 0:
- *                      the call never proceeds; the process stays there until it is killed.
+ *   FOGCL_GATE_RELEASE how many of the program's signal handlers must have returned before the
+ *                      held call proceeds (needs FOGCL_GATE_FD), so it sees what they did. Unset or
+ *                      0: the call never proceeds; the process stays there until it is killed.
  *
  * The Slurm test (tests/slurm/run_slurm_test.sh) holds the open of an input: fogcl refuses a FIFO as
  * an input before it reads any frame, so the gate cannot be a FIFO nobody writes. The signal tests
