@@ -15,14 +15,14 @@ cd "$root"
 "$here/setup.sh" --bench
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build" -j "$(nproc)" --target fogcl_cli fogcl_tests fogcl_bench fogcl_volume_bench \
-  fogcl_exr_peer fogcl_make_sequence fogcl_cuda_interop \
+  fogcl_exr_peer fogcl_make_sequence fogcl_cuda_interop fogcl_call_gate \
   fogcl_interop_bench
 
 rm -rf "$bundle"
 mkdir -p "$bundle/bin" "$bundle/lib"
 bins=("$build/src/fogcl" "$build/tests/fogcl_tests" "$build/bench/fogcl_bench" "$build/bench/fogcl_volume_bench"
       "$build/bench/fogcl_exr_peer" "$build/bench/fogcl_make_sequence" "$build/tests/fogcl_cuda_interop"
-      "$build/bench/fogcl_interop_bench")
+      "$build/bench/fogcl_interop_bench" "$build/tests/fogcl_call_gate.so")
 cp "${bins[@]}" "$bundle/bin/"
 strip --strip-debug "$bundle"/bin/*
 

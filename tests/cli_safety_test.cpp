@@ -11,11 +11,9 @@
 #include <sys/stat.h>
 #include <sys/sysmacros.h>
 #include <sys/un.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -548,31 +546,17 @@ TEST_F(CliSafety, NamedTemporariesFitLongNamesAndSingleFilesSweepTheirOwn) {
 
 // ---- Signals with named temporaries ------------------------------------------------------------
 
-// How a run ended: "exit N" or "signal N".
-std::string ending(int status) {
-  return WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
-                           : WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) : "?";
+// The files in `dir`, sorted.
+std::vector<std::string> files_in(const std::string& dir) {
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator(dir)) found.push_back(e.path().filename().string());
+  std::sort(found.begin(), found.end());
+  return found;
 }
 
-// Starts the CLI and sends `signals` while a named temporary is open, 2 ms apart (so that each is
-// handled before the next: two pending SIGINTs would merge into one); *status as waitpid gives it.
-// False if the run ended before a write was caught.
-bool signal_mid_write(const std::string& args, const std::string& dir, const std::string& log,
-                      const std::vector<int>& signals, int* status) {
-  const pid_t pid = spawn_cli(args, log, true);
-  for (;;) {
-    if (writing_in(pid, dir, false)) break;  // a named temporary
-    if (::waitpid(pid, status, WNOHANG) == pid) return false;
-    std::this_thread::sleep_for(std::chrono::microseconds(100));
-  }
-  for (std::size_t i = 0; i < signals.size(); ++i) {
-    if (i > 0) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    ::kill(pid, signals[i]);
-  }
-  ::waitpid(pid, status, 0);
-  return true;
-}
-
+// Each signal lands while an output is being written: the run is held (tests/support/call_gate.c)
+// at the rename that names frame 3's EXR, its PNG's temporary written too. The next signal is sent
+// once the handler of the one before has returned (two pending SIGINTs would merge into one).
 TEST_F(CliSafety, SignalsLeaveNoNamedTemporary) {
   fs::create_directories(path("in"));
   fs::create_directories(path("out"));
@@ -581,7 +565,7 @@ TEST_F(CliSafety, SignalsLeaveNoNamedTemporary) {
     view.eye.z += 0.1f * float(f);
     PerspectiveCamera camera;
     camera.fov_y_deg = 60.0f;
-    const DemoFrame frame = render_demo_scene(480, 270, camera, view);
+    const DemoFrame frame = render_demo_scene(96, 54, camera, view);
     char name[64];
     std::snprintf(name, sizeof name, "in/color.%04d.exr", f);
     write_exr_rgba(path(name), frame.color);
@@ -590,37 +574,58 @@ TEST_F(CliSafety, SignalsLeaveNoNamedTemporary) {
   }
   const std::string sequence = "apply --color " + path("in/color.####.exr") + " --depth " + path("in/depth.####.exr") +
                                kFog + " --threads 1 --out " + path("out/o.####.exr") + " --png " + path("out/o.####.png");
-  const std::string single = "apply --color " + path("in/color.0001.exr") + " --depth " + path("in/depth.0001.exr") +
-                             kFog + " --threads 1 --out " + path("out/single.exr") + " --png " + path("out/single.png");
-  // One signal in a sequence: the write in progress completes, the run exits 128 + N. A second
-  // signal, or one in a single-file run: the process ends by that signal at once. Either way no
-  // temporary is left.
+  const std::string single = "apply --color " + path("in/color.0003.exr") + " --depth " + path("in/depth.0003.exr") +
+                             kFog + " --threads 1 --out " + path("out/o.0003.exr") + " --png " + path("out/o.0003.png");
+  const std::vector<std::string> two_frames{"o.0001.exr", "o.0001.png", "o.0002.exr", "o.0002.png"};
+  std::vector<std::string> three_frames = two_frames;
+  three_frames.insert(three_frames.end(), {"o.0003.exr", "o.0003.png"});
+  // One signal in a sequence: the write in progress completes (the held rename goes on once the
+  // handler has returned), the run exits 128 + N. A second signal, or one in a single-file run: the
+  // process ends by that signal at once, frame 3 unwritten. Either way no temporary is left.
   const struct {
     const char* what;
     std::string args;
     std::vector<int> signals;
+    int release;  // handled signals after which the held rename goes on (0: never)
     std::string ends;
+    std::vector<std::string> files;  // out/ afterwards
+    std::string says;                // in the log
   } cases[] = {
-      {"sequence, SIGTERM", sequence, {SIGTERM}, "exit 143"},
-      {"sequence, SIGINT", sequence, {SIGINT}, "exit 130"},
-      {"sequence, double Ctrl-C", sequence, {SIGINT, SIGINT}, "signal 2"},
-      {"sequence, SIGINT then SIGTERM", sequence, {SIGINT, SIGTERM}, "signal 15"},
-      {"single file, SIGTERM", single, {SIGTERM}, "signal 15"},
-      {"single file, SIGINT", single, {SIGINT}, "signal 2"},
+      {"sequence, SIGTERM", sequence, {SIGTERM}, 1, "exit 143", three_frames, "interrupted: 3 of 8 frames written"},
+      {"sequence, SIGINT", sequence, {SIGINT}, 1, "exit 130", three_frames, "interrupted: 3 of 8 frames written"},
+      {"sequence, double Ctrl-C", sequence, {SIGINT, SIGINT}, 0, "signal 2", two_frames, ""},
+      {"sequence, SIGINT then SIGTERM", sequence, {SIGINT, SIGTERM}, 0, "signal 15", two_frames, ""},
+      {"single file, SIGTERM", single, {SIGTERM}, 0, "signal 15", {}, ""},
+      {"single file, SIGINT", single, {SIGINT}, 0, "signal 2", {}, ""},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.what);
-    std::string ends;
-    // A run may finish between the signals (or before a write is caught): tried up to 5 times.
-    for (int attempt = 0; attempt < 5 && ends != c.ends; ++attempt) {
-      for (const auto& e : fs::directory_iterator(path("out"))) fs::remove(e.path());
-      int status = 0;
-      ends = signal_mid_write(c.args, path("out"), path("log.txt"), c.signals, &status) ? ending(status) : "no write caught";
-      const std::vector<std::string> left = temporaries_in(path("out"));
-      std::printf("[ signal   ] %s: %s, %zu temporary file(s) left\n", c.what, ends.c_str(), left.size());
-      for (const std::string& f : left) ADD_FAILURE() << "left behind: " << f;
+    for (const auto& e : fs::directory_iterator(path("out"))) fs::remove(e.path());
+    GatedCli run(c.args, path("log.txt"), true, kNamingCalls, "/out/o.0003.exr", c.release);
+    const std::string held = run.next_line();
+    ASSERT_EQ(held, "held rename " + path("out/o.0003.exr")) << read_text(path("log.txt"));
+    // Both files of frame 3 are written under their temporaries; only the naming is left.
+    const std::vector<std::string> writing = temporaries_in(path("out"));
+    EXPECT_EQ(writing.size(), 2u);
+    for (int signo : c.signals) {
+      run.signal(signo);
+      EXPECT_EQ(run.next_line(), "handled " + std::to_string(signo));
     }
-    EXPECT_EQ(ends, c.ends) << read_text(path("log.txt"));
+    const std::string ends = ending(run.wait());
+    const std::string log = read_text(path("log.txt"));
+    const std::vector<std::string> left = temporaries_in(path("out"));
+    std::printf("[ signal   ] %s: %s, %zu temporary file(s) while held, %zu left\n", c.what, ends.c_str(),
+                writing.size(), left.size());
+    EXPECT_EQ(ends, c.ends) << log;
+    EXPECT_EQ(files_in(path("out")), c.files) << log;
+    if (!c.says.empty()) {
+      EXPECT_NE(log.find(c.says), std::string::npos) << log;
+    }
+    for (const std::string& f : c.files) {
+      if (f.size() > 4 && f.compare(f.size() - 4, 4, ".exr") == 0) {
+        EXPECT_NO_THROW(read_exr_color(path("out/" + f))) << f << " is not a complete frame";
+      }
+    }
   }
 }
 

@@ -89,7 +89,6 @@ TEST(FramePipeline, WritesInOrderWithAFewFramesInFlight) {
   EXPECT_EQ(FakeJob::alive.load(), 0);
 }
 
-// The stage times --verbose prints: each stage's own work, not its waits, and the stages overlap.
 // A condition the stages wait for: set() by one stage, wait() by another. wait() gives up after a
 // minute, a hang guard only: in a correct pipeline the condition always comes, so the test's outcome
 // never depends on how fast the machine is.
@@ -111,36 +110,57 @@ class Gate {
   bool open_ = false;
 };
 
+// A clock per thread that moves only when its thread says it worked (work()), as a thread's CPU
+// clock does, by whole seconds: the times the pipeline sums are exact.
+struct WorkClock {
+  using duration = std::chrono::seconds;
+  using rep = duration::rep;
+  using period = duration::period;
+  using time_point = std::chrono::time_point<WorkClock>;
+  static constexpr bool is_steady = true;
+  static time_point now() { return time_point(elapsed); }
+  static void work(int seconds) { elapsed += duration(seconds); }
+  static inline thread_local duration elapsed{0};
+};
+
+// The stage times --verbose prints: each stage's own work, not the rest of its thread's. Reading a
+// frame takes 1 s, fogging 2 s, writing 4 s (WorkClock's); done() takes 8 s on the writer's thread
+// and start() 16 s on the caller's, which no stage counts, nor the stages a failed frame skips. In
+// the threaded run reading also overlaps writing: frame 1's write waits until frame 3 has been read
+// (frame 2 is then between the stages), which stages run in turn never get to.
 TEST(FramePipeline, ReportsEachStagesBusyTime) {
-  using std::chrono::milliseconds;
-  FramePipeline<FakeJob>::Stages s;
-  // Reading overlaps writing: frame 1's write waits until frame 3 has been read (frame 2 is then
-  // between the stages). A pipeline that runs its stages in turn never gets there.
-  Gate third_read;
-  bool overlapped = true;
-  s.read = [&](FakeJob& j) {
-    std::this_thread::sleep_for(milliseconds(10));
-    if (j.frame == 3) third_read.set();
-  };
-  s.fog = [](FakeJob&) {};
-  s.write = [&](FakeJob& j) {
-    if (j.frame == 1) overlapped = third_read.wait();
-    std::this_thread::sleep_for(milliseconds(40));
-  };
-  s.done = [](const FakeJob&) { return true; };
-  const auto outcome = FramePipeline<FakeJob>::run(range(1, 10), s, nullptr);
-  std::printf("[   stages] read %.3f s, fog %.3f s, write %.3f s, wall %.3f s\n", outcome.read_s, outcome.fog_s,
-              outcome.write_s, outcome.total_s);
-  EXPECT_EQ(outcome.finished, 10);
-  EXPECT_TRUE(overlapped) << "frame 3 was not read while frame 1 was being written";
-  // Each stage's time holds at least its sleeps (sleep_for never returns early) ...
-  EXPECT_GE(outcome.read_s, 0.100);
-  EXPECT_GE(outcome.write_s, 0.400);
-  // ... and not its waits: the fog thread waits behind the reader and the writer for most of the
-  // run (over 0.4 s, the writer's sleeps alone), the reader behind the writer once the queues are
-  // full. The margins are the writer's 0.4 s of sleeps, not scheduling luck.
-  EXPECT_LT(outcome.fog_s, 0.5 * outcome.write_s);
-  EXPECT_LT(outcome.read_s, 0.75 * outcome.write_s);
+  for (const bool serial : {false, true}) {
+    SCOPED_TRACE(serial ? "serial" : "threads");
+    using Pipeline = FramePipeline<FakeJob, WorkClock>;
+    Pipeline::Stages s;
+    Gate third_read;
+    bool overlapped = true;
+    s.read = [&](FakeJob& j) {
+      WorkClock::work(1);
+      if (j.frame == 3) third_read.set();
+      if (j.frame == 5) throw Error("frame five is truncated");
+    };
+    s.fog = [](FakeJob&) { WorkClock::work(2); };
+    s.write = [&](FakeJob& j) {
+      if (j.frame == 1 && !serial) overlapped = third_read.wait();
+      WorkClock::work(4);
+    };
+    s.done = [](const FakeJob&) {
+      WorkClock::work(8);
+      return true;
+    };
+    s.start = [] { WorkClock::work(16); };
+    const auto outcome = Pipeline::run(range(1, 10), s, nullptr, serial);
+    std::printf("[   stages] %s: read %.0f s, fog %.0f s, write %.0f s, the caller's thread %.0f s\n",
+                serial ? "serial" : "threads", outcome.read_s, outcome.fog_s, outcome.write_s, outcome.total_s);
+    EXPECT_EQ(outcome.finished, 10);
+    EXPECT_TRUE(overlapped) << "frame 3 was not read while frame 1 was being written";
+    EXPECT_EQ(outcome.read_s, 10.0);
+    EXPECT_EQ(outcome.fog_s, 9 * 2.0);  // frame 5 failed to read: neither fogged nor written
+    EXPECT_EQ(outcome.write_s, 9 * 4.0);
+    // The whole run on the caller's thread: serial, everything; threaded, start() alone.
+    EXPECT_EQ(outcome.total_s, serial ? 16 + 10 + 9 * 2 + 9 * 4 + 10 * 8.0 : 16.0);
+  }
 }
 
 // Stages::start: once, on the caller's thread, while frames are read, fogged and written (apply.cpp
@@ -736,59 +756,35 @@ TEST_F(Sequence, ADeviceThatFailsToOpenAfterTieredFramesStillFailsTheRun) {
 
 // ---- Killed runs -----------------------------------------------------------------------------------
 
-int exit_status(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : WIFSIGNALED(status) ? 128 + WTERMSIG(status) : -1;
-}
-
-// Starts the sequence and sends `signo` while an output is being written. A run that ends before
-// the poll sees a write open (a busy machine can keep the test from looking for a whole frame) is
-// started again on an emptied out_dir, up to 5 times; false if none was caught.
-bool signal_mid_write(const std::string& args, const std::string& out_dir, const std::string& log, bool named,
-                      int signo, int* status) {
-  for (int attempt = 0; attempt < 5; ++attempt) {
-    for (const auto& e : fs::directory_iterator(out_dir)) fs::remove(e.path());
-    const pid_t pid = spawn_cli(args, log, named);
-    for (;;) {
-      if (writing_in(pid, out_dir, true)) {
-        ::kill(pid, signo);
-        *status = exit_status(pid);
-        return true;
-      }
-      int s = 0;
-      if (::waitpid(pid, &s, WNOHANG) == pid) {
-        *status = WIFEXITED(s) ? WEXITSTATUS(s) : -1;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-    std::printf("[ retry    ] the run ended before a write was caught (attempt %d)\n", attempt + 1);
-  }
-  return false;
-}
-
+// Frames 1 to 3 written, frame 4 held (tests/support/call_gate.c) at the call that names its
+// output: a rename from a named temporary, or a link of the unnamed O_TMPFILE inode.
 TEST_F(Sequence, KillDashNineMidWriteLeavesOnlyCompleteFrames) {
-  make_frames(10, 480, 270);
+  make_frames(10, 96, 54);
   const std::string args = inputs() + " --device scalar --threads 1 --out " + path("out/fogged.####.exr");
   for (const bool named : {false, true}) {
     SCOPED_TRACE(named ? "named temporaries (FOGCL_TEMP_FILES=named)" : "O_TMPFILE where the file system has it");
     for (const std::string& f : out_files()) fs::remove(path("out/" + f));
-    int status = 0;
-    ASSERT_TRUE(signal_mid_write(args, path("out"), path("log.txt"), named, SIGKILL, &status))
-        << "the run ended before a write was caught: " << read_text(path("log.txt"));
-    EXPECT_EQ(status, 128 + SIGKILL);
+    GatedCli run(args, path("log.txt"), named, kNamingCalls, "/out/fogged.0004.exr", 0);
+    ASSERT_EQ(run.next_line(), (named ? "held rename " : "held linkat ") + path("out/fogged.0004.exr"))
+        << read_text(path("log.txt"));
+    // Frame 4 is written, not yet named: unnamed, its inode is open in out/ and has no name there.
+    if (!named) {
+      EXPECT_TRUE(writing_in(run.pid(), path("out"), true));
+    }
+    run.signal(SIGKILL);
+    EXPECT_EQ(ending(run.wait()), "signal 9");
     std::vector<std::string> temporaries, frames;
     for (const std::string& f : out_files()) (f.find(".tmp-") != std::string::npos ? temporaries : frames).push_back(f);
-    for (const std::string& f : frames) {
-      EXPECT_EQ(f.size(), std::string("fogged.0001.exr").size()) << f;
-      EXPECT_NO_THROW(read_exr_color(path("out/" + f))) << f << " is not a complete frame";
-    }
+    EXPECT_EQ(frames, (std::vector<std::string>{frame_name("fogged", 1), frame_name("fogged", 2),
+                                                frame_name("fogged", 3)}));
+    for (const std::string& f : frames) EXPECT_NO_THROW(read_exr_color(path("out/" + f))) << f << " is not a complete frame";
     std::printf("[ killed   ] %s: %zu complete frame(s), %zu temporary file(s) left\n",
                 named ? "named" : "unnamed", frames.size(), temporaries.size());
     if (named) {
-      // A named temporary stays after a kill -9; the next run on the sequence sweeps it.
+      // A named temporary stays after a kill -9 (frame 4's, complete); the next run on the
+      // sequence sweeps it.
       ASSERT_EQ(temporaries.size(), 1u);
+      EXPECT_EQ(temporaries[0].rfind(frame_name("fogged", 4) + ".tmp-", 0), 0u) << temporaries[0];
       const CliRun r = run_cli(args + " --verbose", "FOGCL_TEMP_FILES=named");
       ASSERT_EQ(r.exit_code, 0) << r.output;
       EXPECT_NE(r.output.find("removed 1 stale temporary file(s)"), std::string::npos) << r.output;
@@ -820,22 +816,23 @@ TEST_F(Sequence, SweepLeavesOtherFilesAndLiveWritersAlone) {
   EXPECT_TRUE(fs::exists(path("out/" + foreign)));      // not one of this sequence's outputs
 }
 
+// Ctrl-C while frame 4's output is being named (held by tests/support/call_gate.c until the
+// handler has returned): frame 4 completes, frame 5 never starts.
 TEST_F(Sequence, CtrlCSaysHowManyFramesWereWrittenAndLeavesNoPartialFile) {
-  make_frames(10, 480, 270);
+  make_frames(10, 96, 54);
   const std::string args = inputs() + " --device scalar --threads 1 --out " + path("out/fogged.####.exr");
-  int status = 0;
-  ASSERT_TRUE(signal_mid_write(args, path("out"), path("log.txt"), false, SIGINT, &status))
-      << read_text(path("log.txt"));
+  GatedCli run(args, path("log.txt"), false, kNamingCalls, "/out/fogged.0004.exr", 1);
+  ASSERT_EQ(run.next_line().rfind("held ", 0), 0u) << read_text(path("log.txt"));
+  run.signal(SIGINT);
+  EXPECT_EQ(run.next_line(), "handled " + std::to_string(SIGINT));
+  EXPECT_EQ(ending(run.wait()), "exit " + std::to_string(128 + SIGINT));
   const std::string log = read_text(path("log.txt"));
-  EXPECT_EQ(status, 128 + SIGINT) << log;
-  const std::vector<std::string> files = out_files();
-  EXPECT_NE(log.find("fogcl: interrupted: " + std::to_string(files.size()) + " of 10 frames written"),
+  EXPECT_NE(log.find("fogcl: interrupted: 4 of 10 frames written (the last: frame 4); no partial file left"),
             std::string::npos) << log;
-  EXPECT_LT(files.size(), 10u);
-  for (const std::string& f : files) {
-    EXPECT_EQ(f.find(".tmp-"), std::string::npos) << f;
-    EXPECT_NO_THROW(read_exr_color(path("out/" + f))) << f;
-  }
+  std::vector<std::string> four;
+  for (int f = 1; f <= 4; ++f) four.push_back(frame_name("fogged", f));
+  EXPECT_EQ(out_files(), four) << log;
+  for (const std::string& f : out_files()) EXPECT_NO_THROW(read_exr_color(path("out/" + f))) << f;
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "test_support.h"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <stdexcept>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -294,7 +297,11 @@ CliRun run_cli(const std::string& args, const std::string& env) {
   return r;
 }
 
-pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries) {
+namespace {
+// The CLI started in the background (GatedCli) with `env` ("NAME=value") set in the child and
+// descriptor `keep_fd` left open there.
+pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries,
+                     const std::vector<std::string>& env, int keep_fd) {
   std::vector<std::string> words{cli_path()};
   for (std::size_t at = 0; at < args.size();) {
     const std::size_t end = std::min(args.find(' ', at), args.size());
@@ -307,6 +314,8 @@ pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temp
     ::dup2(fd, 1);
     ::dup2(fd, 2);
     if (named_temporaries) ::setenv("FOGCL_TEMP_FILES", "named", 1);
+    for (const std::string& e : env) ::putenv(const_cast<char*>(e.c_str()));
+    if (keep_fd >= 0) ::fcntl(keep_fd, F_SETFD, 0);
     restore_start_opencl_env();
     std::vector<char*> argv;
     for (std::string& w : words) argv.push_back(w.data());
@@ -315,6 +324,66 @@ pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temp
     ::_exit(127);
   }
   return pid;
+}
+
+const std::string& call_gate_path() {
+  static const std::string path = [] {
+    const char* env = std::getenv("FOGCL_TEST_CALL_GATE");  // scripts/gpu-run.sh's bundle
+    return std::string(env != nullptr && *env != '\0' ? env : FOGCL_CALL_GATE_PATH);
+  }();
+  return path;
+}
+}  // namespace
+
+GatedCli::GatedCli(const std::string& args, const std::string& log, bool named_temporaries, const std::string& calls,
+                   const std::string& suffix, int release) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("GatedCli: pipe2 failed");
+  pid_ = spawn_cli(args, log, named_temporaries,
+                   {"LD_PRELOAD=" + call_gate_path(), "FOGCL_GATE_CALLS=" + calls, "FOGCL_GATE_SUFFIX=" + suffix,
+                    "FOGCL_GATE_RELEASE=" + std::to_string(release), "FOGCL_GATE_FD=" + std::to_string(fds[1])},
+                   fds[1]);
+  ::close(fds[1]);  // the child's copy is the only writer: its end is the pipe's end of file
+  lines_ = fds[0];
+}
+
+GatedCli::~GatedCli() {
+  if (pid_ > 0) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+  }
+  if (lines_ >= 0) ::close(lines_);
+}
+
+std::string GatedCli::next_line() {
+  for (;;) {
+    const std::size_t end = pending_.find('\n');
+    if (end != std::string::npos) {
+      const std::string line = pending_.substr(0, end);
+      pending_.erase(0, end + 1);
+      return line;
+    }
+    pollfd p{lines_, POLLIN, 0};
+    if (::poll(&p, 1, 60 * 1000) <= 0) return "";
+    char buf[512];
+    const ssize_t n = ::read(lines_, buf, sizeof buf);
+    if (n <= 0) return "";
+    pending_.append(buf, std::size_t(n));
+  }
+}
+
+void GatedCli::signal(int signo) const { ::kill(pid_, signo); }
+
+int GatedCli::wait() {
+  int status = 0;
+  ::waitpid(pid_, &status, 0);
+  pid_ = -1;
+  return status;
+}
+
+std::string ending(int status) {
+  return WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
+                           : WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) : "?";
 }
 
 bool writing_in(pid_t pid, const std::string& dir, bool unnamed_too) {

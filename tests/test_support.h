@@ -150,8 +150,36 @@ struct CliRun {
 };
 CliRun run_cli(const std::string& args, const std::string& env = "");
 // The fogcl CLI started in the background with `args` (split at spaces, no shell), stdout and
-// stderr into the file `log`; FOGCL_TEMP_FILES=named when named_temporaries. Returns its pid.
-pid_t spawn_cli(const std::string& args, const std::string& log, bool named_temporaries);
+// stderr into the file `log`, FOGCL_TEMP_FILES=named when named_temporaries, and held at one call
+// by tests/support/call_gate.c, preloaded: the first of `calls` (comma-separated function names,
+// e.g. kNamingCalls) on a path ending in `suffix` waits until fogcl's signal handlers have returned
+// `release` times (0: until the process is killed). The gate says what it does in lines that
+// next_line() reads: "held CALL PATH" once it holds, "handled SIGNO" after each handler. No
+// sampling: each step waits for the line before it.
+class GatedCli {
+ public:
+  GatedCli(const std::string& args, const std::string& log, bool named_temporaries, const std::string& calls,
+           const std::string& suffix, int release);
+  ~GatedCli();  // kills a run not waited for
+  GatedCli(const GatedCli&) = delete;
+  GatedCli& operator=(const GatedCli&) = delete;
+  // The gate's next line; "" once the process has ended, or after a minute (a hang guard only: the
+  // line always comes in a run that behaves).
+  std::string next_line();
+  void signal(int signo) const;
+  int wait();  // waitpid's status
+  pid_t pid() const { return pid_; }
+
+ private:
+  pid_t pid_ = -1;
+  int lines_ = -1;  // the read end of the gate's pipe
+  std::string pending_;
+};
+// The calls that give a finished output its name (src/io/atomic_file.cpp): renaming a named
+// temporary, linking an unnamed one.
+inline const std::string kNamingCalls = "rename,renameat,renameat2,linkat";
+// How a run ended, from waitpid's status: "exit N" or "signal N".
+std::string ending(int status);
 // Whether process `pid` has a file open in `dir` for writing an output: a named temporary
 // ("DIR/NAME.tmp-..."), and with unnamed_too an O_TMPFILE inode (shown as "DIR/#INODE (deleted)").
 bool writing_in(pid_t pid, const std::string& dir, bool unnamed_too);

@@ -23,7 +23,8 @@
 namespace fogcl::cli {
 
 // Job: one frame's work in flight; must have `int frame` and `std::string error` ("" = fine).
-template <class Job>
+// Clock: what the stages' busy times are measured with (a test gives a clock of its own).
+template <class Job, class Clock = std::chrono::steady_clock>
 class FramePipeline {
  public:
   using Stage = std::function<void(Job&)>;
@@ -139,7 +140,6 @@ class FramePipeline {
     read_to_fog_.wake();
     fog_to_write_.wake();
   }
-  using Clock = std::chrono::steady_clock;
   // Runs the stage (guarded); returns its wall seconds.
   static double timed(Job& job, const Stage& stage) {
     const auto t = Clock::now();

@@ -302,16 +302,17 @@ say "no OpenCL platform (job $job): task 2 on the scalar path, said in its log, 
 
 # ---- 3. A task that dies mid-run, then only its index again --------------------------------------
 # The same shot into a fresh folder, read through links; task 1's third frame is held: its fogcl
-# has open_gate.so preloaded, whose open() of that file never returns, so the task stops there
-# after two frames, deterministically (a FIFO cannot gate it: fogcl refuses one before any frame).
+# has tests/support/call_gate.c preloaded, whose open() of that file never returns, so the task
+# stops there after two frames, deterministically (a FIFO cannot gate it: fogcl refuses one before
+# any frame).
 mkdir gated
 for f in render/*.exr; do ln -s "../$f" "gated/$(basename "$f")"; done
 gate=gated/color.$(printf '%04d' $((FIRST + CHUNK + 2))).exr
-cc -shared -fPIC -O1 -Wall -Werror -o "$PWD/open_gate.so" "$here/open_gate.c" -ldl || fail "cannot build the open gate (cc)"
+cc -shared -fPIC -O1 -Wall -Werror -o "$PWD/call_gate.so" "$here/../support/call_gate.c" -ldl || fail "cannot build the call gate (cc)"
 export COLOR='gated/color.####.exr' DEPTH='gated/depth.####.exr' OUT='killed/shot.####.exr'
 # Named temporaries, as on NFS, where a killed writer can leave one behind (O_TMPFILE cannot).
 export FOGCL_TEMP_FILES=named
-job=$(LD_PRELOAD="$PWD/open_gate.so" FOGCL_GATE_SUFFIX="$gate" submit --array=0-$((tasks - 1)))
+job=$(LD_PRELOAD="$PWD/call_gate.so" FOGCL_GATE_SUFFIX="$gate" submit --array=0-$((tasks - 1)))
 say "submitted job $job into killed/ with task 1 held at $gate"
 victim_first=$((FIRST + CHUNK))
 written=("killed/$(printf 'shot.%04d.exr' "$victim_first")" "killed/$(printf 'shot.%04d.exr' $((victim_first + 1)))")
