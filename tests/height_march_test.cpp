@@ -3,7 +3,9 @@
 // kernel's polynomials) and double. Lit everywhere, the march over 1, 3, 8 or 64 segments equals
 // §6.2's closed form (fog_height_pixel) within 1e-5; shadowed everywhere it equals the closed form
 // with sun color 0; with one shadow edge on the ray its sun term is within the weight of the
-// segment the edge crosses of the exact half-lit integral.
+// segment the edge crosses of the exact half-lit integral. Then the pass (VolumeSettings::height_fog):
+// the kernel and the scalar march at full resolution against the deferred pass's closed form, lit
+// and shadowed, and the kernel against the scalar march with shafts and volumes.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,7 +15,9 @@
 
 #include <gtest/gtest.h>
 
+#include "fogcl/scalar.h"
 #include "pass/formulas.h"
+#include "volume_support.h"
 
 namespace fogcl::test {
 namespace {
@@ -126,7 +130,7 @@ void march(const Case& c, const T* p, int n, const std::function<double(double)>
     const T v = T(visibility(tail ? double(a) : 0.5 * (double(a) + double(b))));
     for (int ch = 0; ch < 3; ++ch) {
       const T before = sun[ch];
-      fog_height_march_segment<T>(h, h_sun, v, p, ch, &depth_ext[ch], &depth_in[ch], &depth_sun[ch], &ambient[ch],
+      fog_height_march_segment<T>(h, h_sun, v, T(0), T(0), p, ch, &depth_ext[ch], &depth_in[ch], &depth_sun[ch], &ambient[ch],
                                   &sun[ch]);
       if (edges && ch == 0) edges->push_back(double(sun[ch] - before));
     }
@@ -228,6 +232,175 @@ TEST(HeightMarch, ShadowEdgeErrorWithinTheCrossedSegmentsWeight) {
               checked, worst_at[0], worst_at[1], worst_at[2], worst_at[3], worst_ratio);
   EXPECT_GT(checked, 500);
   EXPECT_LT(worst_at[3], worst_at[0]);
+}
+
+
+// A shadow map over every point the test rays reach (|x|, |z| < 1e3, |y| < 400; the camera's far
+// plane is 200 away):
+// filled with 1 everything is lit, with 0 everything is in shadow.
+ShadowMap uniform_shadow_map(float fill) {
+  ShadowMap m;
+  glm::mat4& p = m.params.world_to_light_clip;
+  p = glm::mat4(0.0f);
+  p[0][0] = 1e-3f;
+  p[2][1] = 1e-3f;
+  p[1][2] = 1e-3f;  // light depth 0.5 + 1e-3 y: in (0.1, 0.9) for |y| < 400
+  p[3][2] = 0.5f;
+  p[3][3] = 1.0f;
+  m.depth = DepthImage(8, 8, fill);
+  return m;
+}
+
+// The demo frame without volumes, and a height fog of the variant's parts (falloff, per-channel
+// in-scattering, start, cut-off, sun start, skybox) chosen by `seed`.
+FogSettings marched_fog(const VolumeScene& scene, int seed) {
+  FogSettings f;
+  f.mode = FogMode::height;
+  f.color = glm::vec3(0.6f, 0.7f, 0.8f);
+  f.density = 0.06f;
+  f.height.falloff = seed % 3 == 0 ? 0.0f : 0.35f;
+  f.height.base_height = 0.5f;
+  if (seed % 2) f.height.inscattering = glm::vec3(0.03f, 0.05f, 0.09f);
+  f.height.start = seed % 4 >= 2 ? 1.5f : 0.0f;
+  if (seed % 5 == 1) f.height.cutoff = 40.0f;
+  f.fog_skybox = seed % 3 != 1;
+  SunLobe sun;
+  sun.direction = scene.light.direction;
+  sun.color = glm::vec3(1.5f, 1.2f, 0.9f);
+  sun.exponent = 6.0f;
+  sun.start = seed % 4 == 3 ? 4.0f : 0.0f;
+  f.height.sun = sun;
+  return f;
+}
+
+struct MarchedFrames {
+  double kernel = 0, scalar = 0;  // worst |march - closed form| over RGB
+  double sun = 0;                 // the largest sun term of the closed form (what a shadow removes)
+};
+
+// The test scene's light turned toward the camera's view, so that the lobe shows.
+void face_the_light(VolumeTestScene& t) { t.scene.light.direction = glm::vec3(0.2f, 0.25f, 1.0f); }
+
+// The march (kernel and scalar, full resolution, `steps`) with `shadow` against the deferred
+// pass's closed form of `closed` (the same fog, or without its sun).
+MarchedFrames march_against_closed_form(int seed, int steps, const ShadowMap* shadow, bool without_sun) {
+  VolumeTestScene t = volume_test_scene(48, 30);
+  t.scene.volumes.clear();
+  face_the_light(t);
+  VolumeSettings vs;
+  vs.integrator = VolumeIntegrator::physical;
+  vs.resolution_divisor = 1;
+  vs.steps = steps;
+  vs.height_fog = marched_fog(t.scene, seed);
+  CameraParams posed = t.frame.params;
+  posed.pose = t.scene.pose;
+  FogSettings closed = *vs.height_fog;
+  if (without_sun) closed.height.sun->color = glm::vec3(0.0f);
+  FogSettings unlit = *vs.height_fog;
+  unlit.height.sun->color = glm::vec3(0.0f);
+  ColorImage want, want_lit, want_unlit, got_kernel, got_scalar;
+  apply_fog_scalar(t.frame.color, t.frame.depth, want, posed, closed);
+  apply_fog_scalar(t.frame.color, t.frame.depth, want_lit, posed, *vs.height_fog);
+  apply_fog_scalar(t.frame.color, t.frame.depth, want_unlit, posed, unlit);
+  static VolumePass pass(*runtime());
+  pass.apply(t.frame.color, t.frame.depth, got_kernel, t.frame.params, t.scene, vs, shadow);
+  apply_volumes_scalar(t.frame.color, t.frame.depth, got_scalar, t.frame.params, t.scene, vs, shadow);
+  MarchedFrames r;
+  for (int y = 0; y < want.height(); ++y)
+    for (int x = 0; x < want.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double w = want.pixel(x, y)[c];
+        r.sun = std::max(r.sun, double(want_lit.pixel(x, y)[c]) - double(want_unlit.pixel(x, y)[c]));
+        const double k = std::fabs(double(got_kernel.pixel(x, y)[c]) - w);
+        const double sc = std::fabs(double(got_scalar.pixel(x, y)[c]) - w);
+        r.kernel = std::isnan(k) ? INFINITY : std::max(r.kernel, k);
+        r.scalar = std::isnan(sc) ? INFINITY : std::max(r.scalar, sc);
+      }
+  return r;
+}
+
+// §6.5's normative check on the pass: lit (no shadow map, or one lit everywhere) the composited
+// march is the closed form within 1e-5 at every step count.
+TEST(HeightMarchPass, LitEqualsTheDeferredClosedForm) {
+  FOGCL_REQUIRE_DEVICE();
+  const ShadowMap lit = uniform_shadow_map(1.0f);
+  for (int steps : kSegmentCounts)
+    for (int seed = 0; seed < 6; ++seed)
+      for (const ShadowMap* shadow : {static_cast<const ShadowMap*>(nullptr), &lit}) {
+        const MarchedFrames r = march_against_closed_form(seed, steps, shadow, false);
+        std::printf("lit%s, %2d steps, fog %d: worst |march - closed form| kernel %.3g, scalar %.3g (sun up to %.3g)\n",
+                    shadow ? " map" : "", steps, seed, r.kernel, r.scalar, r.sun);
+        EXPECT_GT(r.sun, 0.05) << "the lobe must show for the check to see it";
+        EXPECT_LE(r.kernel, kLitBudget) << steps << " steps, fog " << seed;
+        EXPECT_LE(r.scalar, kLitBudget) << steps << " steps, fog " << seed;
+      }
+}
+
+// In shadow everywhere, the march is the closed form without its sun term.
+TEST(HeightMarchPass, ShadowedEqualsTheClosedFormWithoutSun) {
+  FOGCL_REQUIRE_DEVICE();
+  const ShadowMap dark = uniform_shadow_map(0.0f);
+  for (int steps : kSegmentCounts)
+    for (int seed = 0; seed < 6; ++seed) {
+      const MarchedFrames r = march_against_closed_form(seed, steps, &dark, true);
+      std::printf("shadowed, %2d steps, fog %d: worst |march - closed form without sun| kernel %.3g, scalar %.3g "
+                  "(sun removed up to %.3g)\n", steps, seed, r.kernel, r.scalar, r.sun);
+      EXPECT_GT(r.sun, 0.05) << "the lobe must show for the check to see it";
+      EXPECT_LE(r.kernel, kLitBudget) << steps << " steps, fog " << seed;
+      EXPECT_LE(r.scalar, kLitBudget) << steps << " steps, fog " << seed;
+    }
+}
+
+// Shafts (the disc blocker's shadow map) through the fog with the test scene's volumes, at half
+// resolution: the kernel against the scalar march.
+TEST(HeightMarchPass, KernelMatchesScalarWithShaftsAndVolumes) {
+  FOGCL_REQUIRE_DEVICE();
+  const ShadowMap shadow = synthetic_shadow_map(false);
+  double worst = 0.0;
+  for (int seed = 0; seed < 6; ++seed) {
+    VolumeTestScene t = volume_test_scene(48, 30);
+    face_the_light(t);
+    VolumeSettings vs;
+    vs.integrator = VolumeIntegrator::physical;
+    vs.steps = 24;
+    vs.height_fog = marched_fog(t.scene, seed);
+    ColorImage got_kernel, got_scalar;
+    static VolumePass pass(*runtime());
+    pass.apply(t.frame.color, t.frame.depth, got_kernel, t.frame.params, t.scene, vs, &shadow);
+    apply_volumes_scalar(t.frame.color, t.frame.depth, got_scalar, t.frame.params, t.scene, vs, &shadow);
+    for (int y = 0; y < got_kernel.height(); ++y)
+      for (int x = 0; x < got_kernel.width(); ++x)
+        for (int c = 0; c < 3; ++c) {
+          const double d = std::fabs(double(got_kernel.pixel(x, y)[c]) - double(got_scalar.pixel(x, y)[c]));
+          worst = std::isnan(d) ? INFINITY : std::max(worst, d);
+        }
+  }
+  std::printf("shafts and volumes: worst |kernel - scalar| %.3g\n", worst);
+  EXPECT_LE(worst, 1e-5);
+}
+
+// What the march cannot take is refused by name.
+TEST(HeightMarchPass, RefusesWhatTheMarchCannotTake) {
+  VolumeTestScene t = volume_test_scene(8, 6);
+  VolumeSettings vs;
+  vs.integrator = VolumeIntegrator::physical;
+  vs.height_fog = marched_fog(t.scene, 0);
+  const auto fails = [&](VolumeSettings s) {
+    ColorImage out;
+    return error_of([&] { apply_volumes_scalar(t.frame.color, t.frame.depth, out, t.frame.params, t.scene, s); });
+  };
+  VolumeSettings s = vs;
+  s.integrator = VolumeIntegrator::stylized;
+  EXPECT_MSG_HAS(fails(s), "physical integrator");
+  s = vs;
+  s.height_fog->height.max_opacity = 0.5f;
+  EXPECT_MSG_HAS(fails(s), "maximum opacity must be 1");
+  s = vs;
+  s.height_fog->height.extinction = glm::vec3(0.1f, 0.2f, 0.1f);
+  EXPECT_MSG_HAS(fails(s), "same in all three channels");
+  s = vs;
+  s.height_fog->mode = FogMode::exp;
+  EXPECT_MSG_HAS(fails(s), "mode must be height");
 }
 
 }  // namespace
