@@ -17,7 +17,7 @@ std::size_t openmp_simd_march(const ColorImage& in, const DepthImage& depth, con
                                 max_eye_depth(depth, camera));
   const int lw = f.low_width, lh = f.low_height;
   low.assign(4 * std::size_t(lw) * lh, 0.0f);
-  if (f.visible.empty()) return std::size_t(lw) * lh;
+  if (f.nothing_to_march()) return std::size_t(lw) * lh;
   const detail::VolumeVariant& v = f.variant;
   const std::uint8_t* noise = f.needs_noise()
                                   ? detail::shared_noise_texture(settings.noise_size, settings.noise_seed).texels.data()
@@ -35,7 +35,7 @@ std::size_t openmp_simd_march(const ColorImage& in, const DepthImage& depth, con
     for (int lx = 0; lx < lw; ++lx) {
       float key;
       const glm::vec4 p = vol_march_pixel<float>(lx, ly, d, frame, vols, count, noise, settings.noise_size, nullptr,
-                                                 scene.frame_index, integrator, v.steps, v.features, v.jitter,
+                                                 scene.frame_index, integrator, v.steps, v.features, v.height_features, v.jitter,
                                                  projection, reversed, int(v.depth_kind), &key);
       float* o = out + 4 * (std::size_t(ly) * lw + lx);
       o[0] = p.x;

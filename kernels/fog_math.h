@@ -651,6 +651,39 @@ FOG_FN_INLINE FOG_INT FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, 
   rgb[2] = FOG_NAME(fog_height_out)(rgb[2], t[2], j[2], j_sun[2], lobe, fogged, p, 2, features);
   return fogged;
 }
+/* The height fog marched (docs/DESIGN.md §6.5): segment [σ_i, σ_i+1] of a ray's fog stretch, channel c.
+ * h: §6.2's H over the segment (fog_height_length), h_sun: H over its part beyond s_sun, v: the
+ * sun's visibility sampled in it (1 lit, 0 shadowed). Adds the segment to the extinction depth
+ * β_ext·ΣH, the in-scattering depths β_in·ΣH and β_in·ΣH_sun, and the ambient and sun fractions
+ * Σ e^(-β_in τ)·(1 - e^(-β_in H_i)) (the sun's times v), whose sums over the segments telescope to
+ * §6.2's J and J_sun: with v = 1 everywhere the march is the closed form, whatever the segments.
+ * other: the optical depth of other media in the segment (0: none), depth_other: theirs in front. */
+FOG_FN_INLINE void FOG_NAME(fog_height_march_segment)(FOG_REAL h, FOG_REAL h_sun, FOG_REAL v, FOG_REAL other,
+                                                      FOG_REAL depth_other, const FOG_HP_T* p, int c,
+                                                      FOG_REAL* depth_ext, FOG_REAL* depth_in, FOG_REAL* depth_sun,
+                                                      FOG_REAL* ambient, FOG_REAL* sun) {
+  FOG_REAL b_in = (FOG_REAL)p[FOG_HP_IN + c];
+  FOG_REAL d_in = FOG_NAME(fog_height_depth)(b_in, h), d_sun = FOG_NAME(fog_height_depth)(b_in, h_sun);
+  /* Other media in the segment (fog volumes, optical depth `other` > 0, never on an infinite tail)
+   * take their share of its scattering: the fog's is d / (d + other) of 1 - e^(-(d + other)). */
+  FOG_REAL share = other > (FOG_REAL)0 ? d_in / (d_in + other) : (FOG_REAL)1;
+  FOG_REAL share_sun = other > (FOG_REAL)0 ? d_sun / (d_sun + other) : (FOG_REAL)1;
+  *ambient = fma(FOG_EXP_NEG(-(*depth_in + depth_other)) * share, -FOG_EXPM1(-(d_in + other)), *ambient);
+  *sun = fma(v * FOG_EXP_NEG(-(*depth_sun + depth_other)) * share_sun, -FOG_EXPM1(-(d_sun + other)), *sun);
+  *depth_in = *depth_in + d_in;
+  *depth_sun = *depth_sun + d_sun;
+  *depth_ext = *depth_ext + FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h);
+}
+
+/* Channel c of a marched pixel: color·T + F·ambient + S·λ·sun with T = e^(-depth_ext), as
+ * fog_height_out blends the closed form's (lobe: λ, read with FOG_HF_SUN). */
+FOG_FN_INLINE FOG_REAL FOG_NAME(fog_height_march_out)(FOG_REAL color, FOG_REAL depth_ext, FOG_REAL ambient,
+                                                      FOG_REAL sun, FOG_REAL lobe, const FOG_HP_T* p, int c,
+                                                      int features) {
+  FOG_REAL s = (features & FOG_HF_SUN) ? (FOG_REAL)p[FOG_HP_SUN + c] * lobe * sun : (FOG_REAL)0;
+  return FOG_NAME(fog_height_blend)(color, FOG_EXP_NEG(-depth_ext), (FOG_REAL)p[FOG_HP_FOG + c], ambient, s);
+}
+
 /* Height fog's geometry of a pixel (docs/DESIGN.md §6.1), in view space: no rotation per pixel.
  * (cx, cy, cz): the pixel's corner ray (fog_bilerp of fog_ray_corners: at the far plane for raw
  * depth, at view z = 1 for linear depth and the infinite far plane; orthographic: the far-plane

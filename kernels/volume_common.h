@@ -105,7 +105,12 @@
 #define VOL_F_SHADOW_BIAS 59
 #define VOL_F_INV_NEAR 60    /* 1 / near, 1 / far (0 with an infinite far plane), rounded once */
 #define VOL_F_INV_FAR 61
-#define VOL_F_COUNT 64
+/* The marched height fog (VOL_FEATURE_HEIGHT, docs/DESIGN.md §6.5): */
+#define VOL_F_HEIGHT_P 64    /* fog_math.h's FOG_HP_* constants (FOG_HP_COUNT = 19) */
+#define VOL_F_HEIGHT_BASE 83 /* base height b [world y] */
+#define VOL_F_HEIGHT_SUN 84  /* unit, toward the sun of the lobe (3) */
+#define VOL_F_HEIGHT_REACH 87 /* an infinite ray's marched stretch ends at this eye depth (0: none) */
+#define VOL_F_COUNT 88
 
 /* One volume's parameters (docs/volumetric.md §A volume), resolved defaults included. */
 #define VOL_V_CENTER 0       /* (3) */

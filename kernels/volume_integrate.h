@@ -10,6 +10,8 @@
 #define VOL_FEATURE_SHADOW 8         /* a shadow map is bound */
 #define VOL_FEATURE_SHADOW_REVERSED 16 /* ... holding reversed Z */
 #define VOL_FEATURE_ADAPTIVE 32      /* stylized: the seed's adaptive stepping */
+#define VOL_FEATURE_HEIGHT 64        /* physical: the height fog marched (docs/DESIGN.md §6.5); its
+                                      * FOG_HF_* bits are VOL_HEIGHT_FEATURES */
 #define VOL_MAX_VOLUMES 32           /* visible volumes per frame (the host checks) */
 
 /* Henyey-Greenstein phase function, normalised over the sphere (1 / 4 pi when g = 0); cos_theta
@@ -240,6 +242,56 @@ VOL_FN VOL_REAL vol_covered(const VOL_REAL* t_in, const VOL_REAL* t_out, VOL_UIN
   return covered;
 }
 
+/* The marched height fog's stretch of a ray (docs/DESIGN.md §6.5): §6.2's [s0, s1] in distance
+ * from the eye (the view plane), as ray parameters [*t0, *t1] (t = s - s_origin, s_origin the
+ * ray origin's distance). An infinite ray (a fogged sky without cut-off) marches to `reach` (or
+ * s0) and sets *infinite: the closed form's tail [*t1, inf) follows. Returns 0 where the ray has
+ * no fog (sky unfogged, empty stretch). */
+VOL_FN int vol_height_stretch(VOL_REAL t_scene, VOL_REAL s_origin, VOL_REAL reach, const VOL_REAL* hp, int hf,
+                              VOL_REAL* t0, VOL_REAL* t1, int* infinite) {
+  const VOL_REAL s0 = (hf & FOG_HF_START) ? hp[FOG_HP_START] : (VOL_REAL)0;
+  VOL_REAL s1;
+  *infinite = 0;
+  if (!(t_scene < (VOL_REAL)INFINITY)) {
+    if (!(hf & FOG_HF_SKYBOX)) return 0;
+    if (hf & FOG_HF_CUTOFF) {
+      s1 = hp[FOG_HP_CUTOFF];
+    } else {
+      *infinite = 1;
+      s1 = fmax(reach, s0);
+    }
+  } else {
+    s1 = t_scene + s_origin;
+    if (hf & FOG_HF_CUTOFF) s1 = fmin(s1, hp[FOG_HP_CUTOFF]);
+  }
+  if (!*infinite && !(s1 > s0)) return 0;
+  *t0 = s0 - s_origin;
+  *t1 = s1 - s_origin;
+  return 1;
+}
+
+/* The marched height fog's segment [ta, tb] of the ray (tb = +inf: the infinite tail), visibility
+ * lit, other media's optical depth `other` in it and depth_v in front: fog_height_march_segment per
+ * channel, H and H_sun from §6.2's fog_height_length (heights from d0 + s wy, s = t + s_origin). */
+VOL_FN void vol_height_segment(VOL_REAL ta, VOL_REAL tb, VOL_REAL s_origin, VOL_REAL wy, VOL_REAL d0,
+                               VOL_REAL lit, VOL_REAL other, VOL_REAL depth_v, const VOL_REAL* hp, int hf,
+                               VOL_REAL* dep_ext, VOL_REAL* dep_in, VOL_REAL* dep_sun, VOL_REAL* amb,
+                               VOL_REAL* sun) {
+  const int falloff = (hf & FOG_HF_FALLOFF) != 0, tail = !(tb < (VOL_REAL)INFINITY);
+  const VOL_REAL sa = ta + s_origin, sb = tail ? (VOL_REAL)INFINITY : tb + s_origin;
+  const VOL_REAL h = fog_height_length(sa, sb, wy, d0, hp[FOG_HP_K], falloff, tail);
+  VOL_REAL h_sun = h;
+  if (hf & FOG_HF_SUN_START) {
+    const VOL_REAL from = fmax(sa, hp[FOG_HP_SUN_START]);
+    h_sun = !(tail || sb > from) ? (VOL_REAL)0
+            : from == sa         ? h
+                                 : fog_height_length(from, sb, wy, d0, hp[FOG_HP_K], falloff, tail);
+  }
+  for (int c = 0; c < ((hf & FOG_HF_RGB) ? 3 : 1); ++c)
+    fog_height_march_segment(h, h_sun, lit, other, depth_v, hp, c, &dep_ext[c], &dep_in[c], &dep_sun[c], &amb[c],
+                             &sun[c]);
+}
+
 /* physical (Hillaire 2015, "Physically Based and Unified Volumetric Rendering in Frostbite"):
  * all volumes of the ray at once, returns (in-scattered I, premultiplied; coverage 1 - T).
  * The ray's covered stretch is cut at every sphere boundary into pieces where the same volumes
@@ -255,21 +307,50 @@ VOL_FN VOL_REAL vol_covered(const VOL_REAL* t_in, const VOL_REAL* t_out, VOL_UIN
  * replaces the segment's exact weight by the textbook left Riemann sum I += T * source * d with T
  * at the segment's start: not energy-conserving, it overshoots by up to sigma_t d when
  * sigma_t d >> 1. The lanes kernel walks the same pieces and segments per lane. */
-VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL jitter,
+VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL t_per_eye, VOL_REAL jitter,
                            VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
                            VOL_NOISE_PARAM, int noise_size, VOL_GLOBAL const float* shadow_map,
-                           int steps, int features, int riemann) {
+                           int steps, int features, int height_features, int riemann) {
   VOL_REAL t_in[VOL_MAX_VOLUMES], t_out[VOL_MAX_VOLUMES], start;
-  const VOL_UINT hit = vol_physical_hits(origin, dir, t_scene, vols, count, t_in, t_out, &start);
+  VOL_UINT hit = vol_physical_hits(origin, dir, t_scene, vols, count, t_in, t_out, &start);
   VOL_REAL i_r = 0, i_g = 0, i_b = 0, depth = 0;
-  if (hit == 0u) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  /* The marched height fog (docs/DESIGN.md §6.5) walks as one more volume, bit `count`, over its
+   * stretch [t_in, t_out]; an infinite ray ends with the closed form's tail. */
+  const int height = (features & VOL_FEATURE_HEIGHT) != 0, hf = height_features;
+  const VOL_UINT fog_bit = height ? 1u << count : 0u;
+  const int walked = height ? count + 1 : count;
+  VOL_REAL hp[FOG_HP_COUNT], fog_ext[3] = {0, 0, 0}, fog_in[3] = {0, 0, 0}, fog_sun_depth[3] = {0, 0, 0};
+  VOL_REAL fog_amb[3] = {0, 0, 0}, fog_sun[3] = {0, 0, 0};
+  VOL_REAL s_origin = 0, wy = 0, d0 = 0, tail_from = 0;
+  int infinite = 0;
+  if (height) {
+    for (int k = 0; k < FOG_HP_COUNT; ++k) hp[k] = VOL_P(frame, VOL_F_HEIGHT_P + k);
+    s_origin = VOL_P(frame, VOL_F_NEAR) * t_per_eye;
+    wy = dir.y;
+    d0 = origin.y - s_origin * dir.y - VOL_P(frame, VOL_F_HEIGHT_BASE);
+    VOL_REAL f0, f1;
+    if (vol_height_stretch(t_scene, s_origin, VOL_P(frame, VOL_F_HEIGHT_REACH) * t_per_eye, hp, hf, &f0, &f1,
+                           &infinite)) {
+      if (infinite)
+        for (int i = 0; i < count; ++i)
+          if ((hit >> i) & 1u) f1 = fmax(f1, t_out[i]); /* the tail starts behind every volume */
+      tail_from = f1;
+      if (f1 > f0) {
+        t_in[count] = f0;
+        t_out[count] = f1;
+        hit |= fog_bit;
+        start = fmin(start, f0);
+      }
+    }
+  }
+  if (hit == 0u && !infinite) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   VOL_REAL phase[VOL_MAX_VOLUMES];
   vol_physical_phases(dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR)), vols, count, phase);
-  const VOL_REAL covered = vol_covered(t_in, t_out, hit, count, start);
+  const VOL_REAL covered = hit != 0u ? vol_covered(t_in, t_out, hit, walked, start) : (VOL_REAL)0;
   VOL_REAL a = start;
-  for (int piece = 0; piece < 2 * count; ++piece) {
+  for (int piece = 0; hit != 0u && piece < 2 * walked; ++piece) {
     VOL_REAL b;
-    const VOL_UINT mask = vol_piece(t_in, t_out, hit, count, a, &b);
+    const VOL_UINT mask = vol_piece(t_in, t_out, hit, walked, a, &b);
     if (!(b < (VOL_REAL)INFINITY)) break;
     if (mask != 0u) {
       const VOL_REAL length_ab = b - a;
@@ -286,8 +367,23 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
         VOL_V3 source;
         const VOL_REAL sigma_t = vol_physical_sample(p, t, phase, lit, mask, vols, count, frame, noise,
                                                      noise_size, features, &source);
+        if (height && (mask & fog_bit)) {
+          /* Extinctions add: the volumes' light shares the segment with the fog's (§6.5). */
+          const VOL_REAL other = sigma_t > (VOL_REAL)0 ? sigma_t * seg : (VOL_REAL)0;
+          const VOL_REAL ext_before = fog_ext[0];
+          vol_height_segment(s0, s1, s_origin, wy, d0, lit, other, depth, hp, hf, fog_ext, fog_in, fog_sun_depth,
+                             fog_amb, fog_sun);
+          if (!(sigma_t > (VOL_REAL)0)) continue;
+          const VOL_REAL scatter =
+              vol_segment_weight(sigma_t + (fog_ext[0] - ext_before) / seg, seg, depth + ext_before, riemann);
+          i_r += source.x * scatter;
+          i_g += source.y * scatter;
+          i_b += source.z * scatter;
+          depth += sigma_t * seg;
+          continue;
+        }
         if (!(sigma_t > (VOL_REAL)0)) continue;
-        const VOL_REAL scatter = vol_segment_weight(sigma_t, seg, depth, riemann);
+        const VOL_REAL scatter = vol_segment_weight(sigma_t, seg, height ? depth + fog_ext[0] : depth, riemann);
         i_r += source.x * scatter;
         i_g += source.y * scatter;
         i_b += source.z * scatter;
@@ -296,14 +392,37 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
     }
     a = b;
   }
-  return VOL_MAKE4(i_r, i_g, i_b, -expm1(-depth));
+  if (!height) return VOL_MAKE4(i_r, i_g, i_b, -expm1(-depth));
+  if (infinite) {
+    const VOL_V3 p = origin + dir * tail_from;
+    const VOL_REAL lit = (features & VOL_FEATURE_SHADOW)
+                             ? vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)
+                             : (VOL_REAL)1;
+    vol_height_segment(tail_from, (VOL_REAL)INFINITY, s_origin, wy, d0, lit, (VOL_REAL)0, depth, hp, hf, fog_ext, fog_in,
+                       fog_sun_depth, fog_amb, fog_sun);
+  }
+  if (!(hf & FOG_HF_RGB)) {
+    fog_amb[1] = fog_amb[2] = fog_amb[0];
+    fog_sun[1] = fog_sun[2] = fog_sun[0];
+  }
+  /* P += F·ambient + S·λ·sun; coverage 1 - e^(-(volumes' depth + the fog's β_ext·H)) (grey). */
+  VOL_REAL lobe = (VOL_REAL)0;
+  if (hf & FOG_HF_SUN) {
+    const VOL_V3 l = VOL_P3(frame, VOL_F_HEIGHT_SUN);
+    lobe = fog_sun_lobe(fog_sun_q(dir.x, dir.y, dir.z, l.x, l.y, l.z), hp[FOG_HP_SUN_EXP]);
+  }
+  i_r += hp[FOG_HP_FOG] * fog_amb[0] + ((hf & FOG_HF_SUN) ? hp[FOG_HP_SUN] * lobe * fog_sun[0] : (VOL_REAL)0);
+  i_g += hp[FOG_HP_FOG + 1] * fog_amb[1] + ((hf & FOG_HF_SUN) ? hp[FOG_HP_SUN + 1] * lobe * fog_sun[1] : (VOL_REAL)0);
+  i_b += hp[FOG_HP_FOG + 2] * fog_amb[2] + ((hf & FOG_HF_SUN) ? hp[FOG_HP_SUN + 2] * lobe * fog_sun[2] : (VOL_REAL)0);
+  return VOL_MAKE4(i_r, i_g, i_b, -expm1(-(depth + fog_ext[0])));
 }
 
 /* The target pixel (lx, ly) as the march sees it: its ray, the distance along it to the occluder,
- * and the block's eye depth in *key for the upsampling. */
+ * the distance per unit of eye depth (vol_pixel_ray) and the block's eye depth in *key for the
+ * upsampling. */
 VOL_FN void vol_pixel_view(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
                            int projection, int reversed_z, int kind, VOL_V3* origin, VOL_V3* dir, VOL_REAL* t_scene,
-                           VOL_REAL* key) {
+                           VOL_REAL* t_per_eye, VOL_REAL* key) {
   const int scale = (int)VOL_P(frame, VOL_F_SCALE);
   const VOL_REAL near_plane = VOL_P(frame, VOL_F_NEAR);
   const VOL_REAL eye_depth = vol_block_eye_depth(depth_buffer, lx, ly, scale, (int)VOL_P(frame, VOL_F_WIDTH),
@@ -311,11 +430,10 @@ VOL_FN void vol_pixel_view(int lx, int ly, VOL_GLOBAL const float* depth_buffer,
                                                  VOL_P(frame, VOL_F_ZX), VOL_P(frame, VOL_F_ZY), near_plane,
                                                  VOL_P(frame, VOL_F_FAR));
   *key = eye_depth;
-  VOL_REAL t_per_eye;
   const VOL_REAL block_centre = (VOL_REAL)scale * (VOL_REAL)0.5f;
   vol_pixel_ray((VOL_REAL)(lx * scale) + block_centre, (VOL_REAL)(ly * scale) + block_centre, frame, projection, origin,
-                dir, &t_per_eye);
-  *t_scene = vol_scene_distance(eye_depth, near_plane, t_per_eye);
+                dir, t_per_eye);
+  *t_scene = vol_scene_distance(eye_depth, near_plane, *t_per_eye);
 }
 
 /* stylized: the volume's (rgb, alpha) c drawn over the target with the seed's blend (SrcAlpha,
@@ -331,14 +449,15 @@ VOL_FN VOL_V4 vol_over(VOL_V4 target, VOL_V4 c) {
 VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
                               VOL_GLOBAL const float* vols, int count, VOL_NOISE_PARAM, int noise_size,
                               VOL_GLOBAL const float* shadow_map, VOL_UINT frame_index, int integrator, int steps,
-                              int features, int jitter, int projection, int reversed_z, int kind, VOL_REAL* key) {
+                              int features, int height_features, int jitter, int projection, int reversed_z, int kind,
+                              VOL_REAL* key) {
   VOL_V3 origin, dir;
-  VOL_REAL t_scene;
-  vol_pixel_view(lx, ly, depth_buffer, frame, projection, reversed_z, kind, &origin, &dir, &t_scene, key);
+  VOL_REAL t_scene, t_per_eye;
+  vol_pixel_view(lx, ly, depth_buffer, frame, projection, reversed_z, kind, &origin, &dir, &t_scene, &t_per_eye, key);
   const float j = vol_jitter((VOL_UINT)lx, (VOL_UINT)ly, frame_index);
   if (integrator != VOL_STYLIZED)
-    return vol_physical(origin, dir, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame, noise,
-                        noise_size, shadow_map, steps, features, integrator == VOL_RIEMANN);
+    return vol_physical(origin, dir, t_scene, t_per_eye, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame,
+                        noise, noise_size, shadow_map, steps, features, height_features, integrator == VOL_RIEMANN);
   /* stylized: each volume drawn over the target in the order given. */
   VOL_V4 target = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   for (int i = 0; i < count; ++i) {

@@ -13,6 +13,8 @@
  *   VOL_NOISE_IMAGE  the noise is a 3D image read with the sampler's linear filter; else a
  *                    buffer of unorm8 texels filtered by volume_noise.h
  *   VOL_LANES        target pixels per work-item: 16 on CPU devices (noise as a buffer), else 1
+ *   VOL_HEIGHT_FEATURES  with VOL_FEATURE_HEIGHT: the marched height fog's FOG_HF_* bits
+ *                    (docs/DESIGN.md §6.5); one pixel per work-item (the lanes do not carry it)
  *
  * Why 16 pixels per work-item on CPUs (docs/volumetric.md §Lanes on CPU devices): PoCL vectorises
  * only across work-items, and the march's per-ray loops and branches keep it out, so each core
@@ -42,6 +44,9 @@
 #else
 #define VOL_REVERSED_Z 0
 #endif
+#ifndef VOL_HEIGHT_FEATURES
+#define VOL_HEIGHT_FEATURES 0 /* FOG_HF_* bits of the marched height fog (VOL_FEATURE_HEIGHT) */
+#endif
 #ifndef VOL_DEPTH_KIND
 #define VOL_DEPTH_KIND 0 /* FOG_DEPTH_RAW; 1 (FOG_DEPTH_EYE): linear eye depth, read as it is */
 #endif
@@ -66,7 +71,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   if (lx >= low_width || ly >= (int)frame[VOL_F_LOW_HEIGHT]) return;
   float key;
   const float4 r = vol_march_pixel(lx, ly, depth, frame, volumes, count, noise, noise_size, shadow_map, frame_index,
-                                   VOL_INTEGRATOR, VOL_STEPS, VOL_FEATURES, VOL_JITTER, FOG_PROJECTION,
+                                   VOL_INTEGRATOR, VOL_STEPS, VOL_FEATURES, VOL_HEIGHT_FEATURES, VOL_JITTER, FOG_PROJECTION,
                                    VOL_REVERSED_Z, VOL_DEPTH_KIND, &key);
   const size_t i = (size_t)ly * (size_t)low_width + (size_t)lx;
   vstore4(r, i, low);
@@ -74,6 +79,9 @@ kernel void volume_march(global const float* depth, global const float* frame, g
 }
 
 #elif VOL_LANES == 16
+#if VOL_FEATURES & VOL_FEATURE_HEIGHT
+#error "the marched height fog runs one pixel per work-item"
+#endif
 #ifdef VOL_NOISE_IMAGE
 #error "VOL_LANES 16 reads the noise as a buffer"
 #endif
@@ -222,7 +230,9 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   for (int k = 0; k < 16; ++k) {
     const int lx = min(lx0 + k, low_width - 1);
     float3 o, d;
-    vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, VOL_DEPTH_KIND, &o, &d, &scene[k], &key[k]);
+    float t_per_eye;
+    vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, VOL_DEPTH_KIND, &o, &d, &scene[k], &t_per_eye,
+                   &key[k]);
     ox[k] = o.x, oy[k] = o.y, oz[k] = o.z, dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
     const float j = vol_jitter((uint)lx, (uint)ly, frame_index);
     jitter[k] = VOL_JITTER ? j : VOL_INTEGRATOR == VOL_STYLIZED ? 0.0f : 0.5f;

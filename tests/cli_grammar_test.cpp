@@ -73,7 +73,8 @@ const std::map<std::string, std::map<std::string, FlagSpec>>& flag_table() {
         // height fog
         {"--extinction", {Kind::vec3}}, {"--inscattering", {Kind::vec3}}, {"--height-falloff", {Kind::real}},
         {"--base-height", {Kind::real}}, {"--cutoff", {Kind::real}}, {"--max-opacity", {Kind::real}},
-        {"--sun-color", {Kind::vec3}}, {"--sun-exponent", {Kind::real}}, {"--sun-start", {Kind::real}}}},
+        {"--sun-color", {Kind::vec3}}, {"--sun-exponent", {Kind::real}}, {"--sun-start", {Kind::real}},
+        {"--height-volumetric", {Kind::none}}}},
   };
   return table;
 }

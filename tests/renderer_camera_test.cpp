@@ -79,7 +79,7 @@ glm::dmat3 rotation(double ax_deg, double ay_deg, double az_deg) {
 // space, as the volume pass gets it: the packed frame's camera rotation times the bilinear corner
 // ray (docs/volumetric.md, "World and rays").
 struct FogclRays {
-  std::array<float, 64> frame{};
+  std::array<float, VOL_F_COUNT> frame{};
   glm::dvec3 at(double u, double v) const {
     const auto c = [&](int k) {
       return glm::dvec3(frame[std::size_t(VOL_F_CORNERS + 3 * k)], frame[std::size_t(VOL_F_CORNERS + 3 * k + 1)],

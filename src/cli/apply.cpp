@@ -332,7 +332,8 @@ bool tiers(const ApplyOptions& o, int cores) {
   const std::string choice = env == nullptr ? "" : env;
   if (choice != "" && choice != "on" && choice != "off")
     throw Error("FOGCL_TIERING must be on or off (got '" + choice + "')");
-  return choice != "off" && cores > 1 && o.volumes.volumes_path.empty() && !o.max_error_given &&
+  return choice != "off" && cores > 1 && o.volumes.volumes_path.empty() && !o.volumes.height_fog &&
+         !o.max_error_given &&
          o.settings.precision == Precision::precise && resolve_device_choice(o.device) == "cpu";
 }
 

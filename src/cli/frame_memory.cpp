@@ -137,7 +137,7 @@ FrameMemoryNeeds frame_memory_needs(const ApplyOptions& o) {
   FrameMemoryNeeds needs;
   needs.half_output = o.pixel_type == "half";
   needs.png = !o.png_path.empty();
-  needs.volumes = !o.volumes.volumes_path.empty();
+  needs.volumes = !o.volumes.volumes_path.empty() || o.volumes.height_fog.has_value();
   const std::string& r = o.volumes.resolution;
   needs.volume_divisor = o.volumes.max_error_given ? 1 : r == "half" ? 2 : r == "quarter" ? 4 : 1;
   needs.volumes_scalar = resolve_device_choice(o.device) == "scalar";

@@ -20,7 +20,8 @@ namespace fogcl::cli {
 namespace {
 
 const char* const kHeightFlags[] = {"--extinction", "--inscattering", "--height-falloff", "--base-height", "--cutoff",
-                                    "--max-opacity", "--sun-color", "--sun-exponent", "--sun-start"};
+                                    "--max-opacity", "--sun-color", "--sun-exponent", "--sun-start",
+                                    "--height-volumetric"};
 
 using detail::str;
 
@@ -69,6 +70,10 @@ void add_height_options(CLI::App& app, HeightCliOptions& o) {
   app.add_option("--sun-exponent", o.sun_exponent, "Sun lobe exponent, > 0 (default 8; larger is tighter)")
       ->check(real_check("--sun-exponent", kPositive))
       ->group(group);
+  app.add_flag("--height-volumetric", o.volumetric,
+               "March the height fog in the volumetric pass: light shafts where --shadow-map shadows the sun "
+               "(--light-dir); lit, the same image as without it (docs/DESIGN.md §6.5)")
+      ->group(group);
   app.add_option("--sun-start", o.sun_start, "Sun lobe start distance along the ray [world units], >= 0 (default 0)")
       ->check(real_check("--sun-start", kNonNegative))
       ->group(group);
@@ -84,7 +89,7 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
   }
   // --eye/--forward/--up and --light-dir are this mode's too: not only the volumes'.
   auto& vg = ap.volumes.given;
-  if (ap.volumes.volumes_path.empty())
+  if (ap.volumes.volumes_path.empty() && !o.volumetric)
     for (const char* flag : {"--eye", "--forward", "--up", "--light-dir"})
       vg.erase(std::remove(vg.begin(), vg.end(), std::string(flag)), vg.end());
 
@@ -166,6 +171,13 @@ void resolve_height_flags(const CLI::App& app, ApplyOptions& ap) {
       if (given(flag)) throw Error(std::string(flag) + " needs --sun-color (the sun lobe's color)");
   }
   validate(ap.settings);  // the library's own rules, after the flags' (the same rules: a safety net)
+  if (o.volumetric) {
+    if (ap.camera.matrix)
+      throw Error("--height-volumetric takes the pose from --eye/--forward/--up, not --camera-to-world");
+    // The volumetric pass marches the fog; the deferred pass then has none to apply.
+    ap.volumes.height_fog = ap.settings;
+    ap.settings.mode = FogMode::off;
+  }
 }
 
 std::optional<CameraPose> height_frame_pose(const ApplyOptions& ap, const ExrInput& color, std::string* from) {

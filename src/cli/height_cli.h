@@ -21,6 +21,7 @@ struct ApplyOptions;
 struct HeightCliOptions {
   std::string extinction, inscattering, falloff, base_height, cutoff, max_opacity;
   std::string sun_color, sun_exponent, sun_start;
+  bool volumetric = false;  // --height-volumetric: marched with the volumes (docs/DESIGN.md §6.5)
   // Resolved by resolve_height_flags: the fixed pose from --eye/--forward/--up (fogcl's world),
   // or none when each frame brings it (--camera-to-world).
   std::optional<CameraPose> pose;

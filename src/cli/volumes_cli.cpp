@@ -205,14 +205,14 @@ ShadowMap read_shadow_map(const std::string& path, const glm::mat4& world_to_lig
 }
 
 std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, const Runtime* runtime) {
-  if (o.volumes_path.empty()) {
+  if (o.volumes_path.empty() && !o.height_fog) {
     if (!o.given.empty()) throw Error(o.given.front() + " needs --volumes (it sets up the volumetric pass)");
     return nullptr;
   }
   if (!o.pose_per_frame)  // else each frame brings its pose (set_frame_pose)
     for (const char* flag : {"--eye", "--forward", "--up"})
       if (!given(o, flag))
-        throw UsageError(std::string(flag) + " is required with --volumes (the camera pose, X,Y,Z; or give "
+        throw UsageError(std::string(flag) + " is required with --volumes or --height-volumetric (the camera pose, X,Y,Z; or give "
                          "--camera-to-world, or none of --eye/--forward/--up to take the color file's worldToCamera)");
   auto stage = std::unique_ptr<VolumeStage>(new VolumeStage);
   VolumeStage& s = *stage;
@@ -255,6 +255,12 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
   if (o.noise_seed < 0 || o.noise_seed > 4294967295LL)
     throw Error("--noise-seed must be in [0, 4294967295] (got " + std::to_string(o.noise_seed) + ")");
   st.noise_seed = std::uint32_t(o.noise_seed);
+  if (o.height_fog) {
+    st.height_fog = o.height_fog;
+    if (!given(o, "--integrator")) st.integrator = VolumeIntegrator::physical;  // the march's only integrator
+    if (st.integrator == VolumeIntegrator::stylized)
+      throw Error("--height-volumetric needs --integrator physical (got stylized)");
+  }
   validate(st);
 
   // Shadow map: both halves or neither.
@@ -289,7 +295,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
       throw Error("--max-error must be a number >= 0 (got " + str(o.max_error) + ")");
   }
 
-  s.volumes_ = read_volumes_json(o.volumes_path);
+  if (!o.volumes_path.empty()) s.volumes_ = read_volumes_json(o.volumes_path);
   for (FogVolume& v : s.volumes_) v = volume_to_fogcl(axes, v);
   s.runtime_ = runtime;
   if (runtime != nullptr) s.pass_ = std::make_unique<VolumePass>(*runtime);

@@ -25,7 +25,10 @@ namespace fogcl::cli {
 
 // The volume flags as given (vectors as text "X,Y,Z", parsed with messages that name the flag).
 struct VolumeCliOptions {
-  std::string volumes_path;      // --volumes: "" = no volumetric pass
+  std::string volumes_path;      // --volumes: "" = no volumes (no volumetric pass unless height_fog)
+  // --mode height --height-volumetric: the height fog marched in the volumetric pass (set by
+  // resolve_height_flags; the deferred pass then runs no height fog).
+  std::optional<FogSettings> height_fog;
   std::string eye, forward, up;  // required with --volumes
   std::string light_dir = "0,1,0", light_color = "1,1,1";
   double time = 0.0;    // --time [s]

@@ -22,6 +22,7 @@
 #include "image/packed_frame.h"
 #include "runtime/format.h"
 #include "runtime/host_staging.h"
+#include "settings/fog_coefficients.h"
 #include "volume/volume_formulas.h"
 
 namespace fogcl {
@@ -135,6 +136,20 @@ void validate(const VolumeSettings& s) {
                 std::to_string(s.resolution_divisor) + ")");
   if (s.noise_size != 32 && s.noise_size != 64 && s.noise_size != 128)
     throw Error("noise size must be 32, 64 or 128 (got " + std::to_string(s.noise_size) + ")");
+  if (s.height_fog) {
+    const FogSettings& f = *s.height_fog;
+    if (f.mode != FogMode::height) throw Error("the marched height fog's mode must be height (VolumeSettings::height_fog)");
+    validate(f);
+    if (s.integrator == VolumeIntegrator::stylized)
+      throw Error("the marched height fog needs the physical integrator (got stylized)");
+    if (f.height.max_opacity != 1.0f)
+      throw Error("the marched height fog's maximum opacity must be 1 (got " + str(f.height.max_opacity) +
+                  "): a clamp of the whole ray cannot be applied per segment");
+    const glm::vec3 e = detail::height_extinction(f);
+    if (e.x != e.y || e.x != e.z)
+      throw Error("the marched height fog's extinction must be the same in all three channels (got " + str(e.x) +
+                  ", " + str(e.y) + ", " + str(e.z) + ")");
+  }
 }
 
 void validate(const VolumeScene& s) {
@@ -315,6 +330,9 @@ float max_eye_depth(const ConstDepthView& depth, const CameraParams& camera, Cop
 }
 
 bool PackedVolumeFrame::needs_noise() const { return (variant.features & VOL_FEATURE_NOISE) != 0; }
+bool PackedVolumeFrame::nothing_to_march() const {
+  return visible.empty() && !(variant.features & VOL_FEATURE_HEIGHT);
+}
 
 void pack_depth_constants(float* frame, const CameraParams& camera) {
   frame[VOL_F_NEAR] = camera.near_plane();
@@ -324,6 +342,33 @@ void pack_depth_constants(float* frame, const CameraParams& camera) {
   frame[VOL_F_ZX] = camera.zbuffer_params.x;
   frame[VOL_F_ZY] = camera.zbuffer_params.y;
 }
+
+namespace {
+// The marched height fog (docs/DESIGN.md §6.5) into the frame and the variant: the deferred pass's
+// variant selection gives the FOG_HF_* bits (none: the fog is empty, no code for it).
+void pack_height_fog(PackedVolumeFrame& out, const FogSettings& fog, const CameraParams& camera,
+                     const CameraPose& pose) {
+  CameraParams posed = camera;
+  posed.pose = pose;
+  const Variant fv = select_variant(fog, posed, ColorFormat::rgba32f);
+  if (fv.mode != KernelMode::height) return;
+  VolumeVariant& v = out.variant;
+  v.features |= VOL_FEATURE_HEIGHT;
+  v.height_features = fv.height_features | (fog.fog_skybox ? FOG_HF_SKYBOX : 0);
+  // The volumes' buffer is bound even when no volume is visible: one unread entry.
+  if (out.volumes.empty()) out.volumes.assign(VOL_V_STRIDE, 0.0f);
+  float* k = out.frame.data();
+  const HeightCoefficients<float> hc = height_coefficients<float>(fog, posed);
+  for (int i = 0; i < FOG_HP_COUNT; ++i) k[VOL_F_HEIGHT_P + i] = hc.p[i];
+  k[VOL_F_HEIGHT_BASE] = fog.height.base_height;
+  if (fog.height.sun) {
+    const glm::vec3 l = glm::vec3(glm::normalize(glm::dvec3(fog.height.sun->direction)));
+    k[VOL_F_HEIGHT_SUN] = l.x, k[VOL_F_HEIGHT_SUN + 1] = l.y, k[VOL_F_HEIGHT_SUN + 2] = l.z;
+  }
+  // An infinite ray marches to the far plane (an infinite far plane: no stretch, the tail alone).
+  k[VOL_F_HEIGHT_REACH] = camera.projection == Projection::perspective_infinite_far ? 0.0f : camera.far_plane();
+}
+}  // namespace
 
 PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& camera, const VolumeScene& scene,
                                     const VolumeSettings& settings, ColorFormat storage,
@@ -346,6 +391,9 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   if (out.visible.size() > VOL_MAX_VOLUMES)
     throw Error(std::to_string(out.visible.size()) + " fog volumes are visible in this frame; at most " +
                 std::to_string(VOL_MAX_VOLUMES) + " are supported");
+  if (settings.height_fog && out.visible.size() >= VOL_MAX_VOLUMES)
+    throw Error(std::to_string(out.visible.size()) + " fog volumes are visible in this frame; at most " +
+                std::to_string(VOL_MAX_VOLUMES - 1) + " are supported with the marched height fog");
   const int s = settings.resolution_divisor;
   out.low_width = (width + s - 1) / s;
   out.low_height = (height + s - 1) / s;
@@ -431,6 +479,7 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
     k[VOL_F_SHADOW_HEIGHT] = float(shadow_height);
     k[VOL_F_SHADOW_BIAS] = shadow->bias;
   }
+  if (settings.height_fog) pack_height_fog(out, *settings.height_fog, camera, scene.pose);
   return out;
 }
 
@@ -447,6 +496,8 @@ int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
   // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
   // work-items, which the march's loops prevent; the lanes instance has no image sampling.
   const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
+  // The marched height fog runs one pixel per work-item: the lanes instance does not carry it.
+  if (v.features & VOL_FEATURE_HEIGHT) return 1;
   return pixels_per_work_item(device) == 16 && buffer ? 16 : 1;
 }
 
@@ -456,6 +507,7 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
   o += " -D VOL_INTEGRATOR=" + std::to_string(integrator_code(v.integrator));
   o += " -D VOL_STEPS=" + std::to_string(v.steps);
   o += " -D VOL_FEATURES=" + std::to_string(v.features);
+  if (v.features & VOL_FEATURE_HEIGHT) o += " -D VOL_HEIGHT_FEATURES=" + std::to_string(v.height_features);
   o += " -D VOL_JITTER=" + std::to_string(v.jitter ? 1 : 0);
   o += " -D FOG_PROJECTION=" + std::to_string(int(v.projection));
   if (v.reversed_z) o += " -D REVERSED_Z";
@@ -469,13 +521,15 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
 // The private arrays per target pixel (a lane) of kernels/volume_march.cl, in 4-byte words: the
 // ray, its occluder, key, jitter and result (13); the staging of the noise and shadow-map helpers
 // inlined into it (10); the stylized march's per-volume entries (7), or the physical walk's state
-// (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES). Twice that for what the
+// (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES); with the marched height
+// fog its FOG_HP_* constants and its per-channel sums (20). Twice that for what the
 // compiler keeps besides (spilled vectors, copies): PoCL 3.1's work-group functions hold 0.9-1.15x
 // the arrays per work-item (their stack frames: 6.4-6.8 KB physical, 1.7-2.2 KB stylized at 16
 // lanes).
 std::size_t volume_march_private_bytes(const VolumeVariant& v, const DeviceTraits& device) {
   const std::size_t per_lane =
-      13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES);
+      13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES) +
+      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 20 : 0);  // the marched fog's constants and sums
   return 2 * 4 * per_lane * std::size_t(volume_march_lanes(v, device));
 }
 

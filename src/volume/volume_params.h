@@ -21,6 +21,7 @@ struct VolumeVariant {
   VolumeIntegrator integrator = VolumeIntegrator::stylized;
   int steps = 50;
   int features = 0;           // VOL_FEATURE_* bits
+  int height_features = 0;    // VOL_FEATURE_HEIGHT: the marched height fog's FOG_HF_* bits (VOL_HEIGHT_FEATURES)
   bool jitter = true;
   Projection projection = Projection::perspective;
   bool reversed_z = false;
@@ -33,12 +34,14 @@ struct VolumeVariant {
 
 // A frame ready to march: the visible volumes packed, the frame constants, the variant.
 struct PackedVolumeFrame {
-  std::array<float, 64> frame{};   // VOL_F_COUNT floats
+  std::array<float, 88> frame{};   // VOL_F_COUNT floats
   std::vector<float> volumes;      // VOL_V_STRIDE floats per visible volume
   std::vector<std::size_t> visible;  // indices into scene.volumes
   VolumeVariant variant;
   int low_width = 0, low_height = 0;
   bool needs_noise() const;
+  // No volume visible and no marched height fog: the pass draws nothing, the output is the input.
+  bool nothing_to_march() const;
 };
 
 class CopyWorkers;

@@ -240,7 +240,7 @@ void VolumePass::prepare(const CameraParams& camera, const VolumeScene& scene, c
                 " has none (use 'buffer')");
   const detail::PackedVolumeFrame f =
       detail::pack_volume_frame(1, 1, camera, scene, settings, storage, shadow, 1, 1, INFINITY);
-  if (f.visible.empty()) return;
+  if (f.nothing_to_march()) return;
   m.build(kMarch, detail::volume_march_options(f.variant, m.traits),
           detail::volume_march_private_bytes(f.variant, m.traits));
   m.build(kComposite, detail::volume_composite_options(f.variant, m.traits),
@@ -315,7 +315,7 @@ cl::Event VolumePass::Impl::enqueue_frame(const cl::CommandQueue& queue, const F
   }
   cl::Event done;
   m.stats.volumes_culled += scene.volumes.size() - f.visible.size();
-  if (f.visible.empty()) {  // nothing to draw: no kernel, the output is the input
+  if (f.nothing_to_march()) {  // nothing to draw: no kernel, the output is the input
     m.last_march_options.clear();
     m.last_composite_options.clear();
     ++m.stats.frames_without_volumes;
@@ -478,7 +478,7 @@ void VolumePass::Impl::apply(VolumePass& pass, const ConstColorView& in, const C
   const detail::PackedVolumeFrame f = detail::pack_volume_frame(
       in.width(), in.height(), camera, scene, settings, in.format(), shadow ? &shadow->params : nullptr,
       shadow ? shadow->depth.width() : 0, shadow ? shadow->depth.height() : 0, max_eye);
-  if (f.visible.empty()) {
+  if (f.nothing_to_march()) {
     ++m.stats.frames_without_volumes;
     m.stats.volumes_culled += scene.volumes.size();
     m.last_march_options.clear();

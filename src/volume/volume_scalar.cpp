@@ -38,7 +38,7 @@ VolumeResult<T> volumes_in(const ConstColorView& in, const ConstDepthView& depth
       const glm::vec4 c = in.pixel(x, y);
       for (int k = 0; k < 4; ++k) r.rgba[4 * (std::size_t(y) * w + x) + k] = T(c[k]);
     }
-  if (f.visible.empty()) return r;
+  if (f.nothing_to_march()) return r;
 
   const detail::VolumeVariant& v = f.variant;
   const std::uint8_t* noise = f.needs_noise()
@@ -57,7 +57,8 @@ VolumeResult<T> volumes_in(const ConstColorView& in, const ConstDepthView& depth
       T key;
       const glm::vec<4, T> p = vol_march_pixel<T>(
           lx, ly, depth.data(), f.frame.data(), f.volumes.data(), int(f.visible.size()), noise, settings.noise_size,
-          shadow_map, scene.frame_index, integrator, v.steps, v.features, v.jitter, projection, reversed, kind, &key);
+          shadow_map, scene.frame_index, integrator, v.steps, v.features, v.height_features, v.jitter, projection,
+          reversed, kind, &key);
       for (int k = 0; k < 4; ++k) r.low[4 * i + k] = p[k];
       r.low_key[i] = key;
     }

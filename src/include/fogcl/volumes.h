@@ -13,6 +13,7 @@
 #include <glm/vec4.hpp>
 
 #include "fogcl/camera.h"
+#include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
 
 namespace fogcl {
@@ -122,6 +123,14 @@ struct VolumeSettings {
   int noise_size = 64;                   // noise texels per side: 32, 64 or 128
   std::uint32_t noise_seed = 1;
   NoiseSampling noise_sampling = NoiseSampling::automatic;  // resolved per device by the pass
+  // The height fog marched with the volumes (docs/DESIGN.md §6.5): light shafts where the shadow
+  // map shadows the sun. Unset (default): no height fog in this pass, and no code for it. Set: its
+  // mode must be FogMode::height; the fog is §6's (FogSettings::height, color, density,
+  // fog_skybox), with the physical integrator, grey extinction (one β_ext for all three channels;
+  // in-scattering may differ per channel), maximum opacity 1, and at most 31 visible volumes. The
+  // lobe's direction is FogSettings::height.sun's (give it the main light's direction). The
+  // deferred pass must then not also apply the height fog: this pass's composite replaces it.
+  std::optional<FogSettings> height_fog;
 };
 
 // What changes from frame to frame.
