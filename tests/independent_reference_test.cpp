@@ -429,10 +429,12 @@ TEST(IndependentReference, ScalarDeferredFogMatchesUnitysFactors) {
 TEST(IndependentReference, KernelDeferredFogMatchesUnitysFactors) {
   Device& d = device();
   if (!d.runtime) GTEST_SKIP() << "no OpenCL device: " << d.error;
-  for (auto& [name, pass] : d.passes)
-    check_scenes(name.c_str(), kDeferredScenes / 2, 1000, kDeferredBudget, deferred_scene, deferred_reference,
+  for (auto& entry : d.passes) {  // not a structured binding: clang refuses to capture one before C++20
+    auto& pass = entry.second;
+    check_scenes(entry.first.c_str(), kDeferredScenes / 2, 1000, kDeferredBudget, deferred_scene, deferred_reference,
                  [&](const Scene& sc, ColorImage& out) { pass->apply(sc.color, sc.depth, out, sc.camera, sc.settings); },
                  deferred_scale);
+  }
 }
 
 TEST(IndependentReference, ScalarHeightFogMatchesTheQuadrature) {
@@ -442,10 +444,12 @@ TEST(IndependentReference, ScalarHeightFogMatchesTheQuadrature) {
 TEST(IndependentReference, KernelHeightFogMatchesTheQuadrature) {
   Device& d = device();
   if (!d.runtime) GTEST_SKIP() << "no OpenCL device: " << d.error;
-  for (auto& [name, pass] : d.passes)
-    check_scenes(name.c_str(), kHeightScenes / 2, 5000, kHeightBudget, height_scene, height_reference,
+  for (auto& entry : d.passes) {  // not a structured binding: clang refuses to capture one before C++20
+    auto& pass = entry.second;
+    check_scenes(entry.first.c_str(), kHeightScenes / 2, 5000, kHeightBudget, height_scene, height_reference,
                  [&](const Scene& sc, ColorImage& out) { pass->apply(sc.color, sc.depth, out, sc.camera, sc.settings); },
                  height_scale);
+  }
 }
 
 TEST(IndependentReference, ScalarStylizedVolumesMatchTheClosedForm) {
