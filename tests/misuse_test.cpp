@@ -126,7 +126,8 @@ TEST(Misuse, PixelAccessOutOfRangeIsAnError) {
   ColorImage c(5, 3, ColorFormat::rgba16f);
   DepthImage d(5, 3);
   const DepthImage& cd = d;
-  for (const auto& [x, y] : std::initializer_list<std::pair<int, int>>{{5, 0}, {0, 3}, {-1, 0}, {0, -1}, {1000000, 2}}) {
+  for (const auto& xy : std::initializer_list<std::pair<int, int>>{{5, 0}, {0, 3}, {-1, 0}, {0, -1}, {1000000, 2}}) {
+    const int x = xy.first, y = xy.second;  // not a structured binding: the lambdas capture them
     EXPECT_TRUE(contains(error_of([&] { c.pixel(x, y); }), "outside the 5x3 image"));
     EXPECT_TRUE(contains(error_of([&] { c.set_pixel(x, y, glm::vec4(1.0f)); }), "outside the 5x3 image"));
     EXPECT_TRUE(contains(error_of([&] { d.at(x, y) = 1.0f; }), "outside the 5x3 image"));
