@@ -34,11 +34,12 @@ gpu-bundle:
 # and the libFuzzer targets over EXR loading and VOLUMES.json, from one build folder.
 # detect_leaks=0: PoCL and the OpenCL ICD loader keep process-lifetime allocations (LLVM's JIT
 # state, the platform list) that LeakSanitizer reports at exit; fogcl's own leaks would show in the
-# scalar/IO tests (docs/cli.md, "Errors").
+# scalar/IO tests (docs/cli.md, "Errors"). allocator_may_return_null=1: an allocation too large for
+# ASan's allocator fails as it does without ASan (the misuse tests check the error it becomes).
 ASAN_BUILD ?= build-asan
 SANITIZE := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 FUZZ_SECONDS ?= 30
-export ASAN_OPTIONS ?= detect_leaks=0:abort_on_error=1
+export ASAN_OPTIONS ?= detect_leaks=0:abort_on_error=1:allocator_may_return_null=1
 export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
 
 asan-build:

@@ -468,7 +468,11 @@ FOG_FN_INLINE FOG_REAL FOG_NAME(fog_log1p_neg_poly)(FOG_REAL y) {
  * -1 once s < 2^-25); NaN never comes in. Returns e^x, writes e^x - 1. */
 FOG_FN_INLINE FOG_REAL FOG_NAME(fog_exp_expm1_neg_poly)(FOG_REAL x, FOG_REAL* expm1_x) {
   FOG_REAL n;
-  FOG_REAL em = FOG_NAME(fog_expm1_reduced)(FOG_NAME(fog_ln2_reduce)(fmax(x, (FOG_REAL)-87.0f), &n));
+  /* Held to [-87, 0] (the same bits there): a positive x, whose result a caller's select drops,
+   * would otherwise ask fog_pow2i for 2^n beyond float's exponent (and the C++ path for an int
+   * conversion out of range). */
+  FOG_REAL em = FOG_NAME(fog_expm1_reduced)(
+      FOG_NAME(fog_ln2_reduce)(fmin(fmax(x, (FOG_REAL)-87.0f), (FOG_REAL)0), &n));
   FOG_REAL s = FOG_NAME(fog_pow2i)(n);
   *expm1_x = fma(s, em, s - (FOG_REAL)1); /* n = 0: em itself */
   return x < (FOG_REAL)-87.0f ? (FOG_REAL)0 : fma(s, em, s);
