@@ -31,6 +31,8 @@ using Rng = std::mt19937_64;
 double unit(Rng& rng) { return std::uniform_real_distribution<double>(0.0, 1.0)(rng); }
 bool coin(Rng& rng, double p = 0.5) { return unit(rng) < p; }
 double log_uniform(Rng& rng, double lo, double hi) { return lo * std::pow(hi / lo, unit(rng)); }
+// The float next to x that is still finite (above x, or below it at FLT_MAX).
+float beside(float x) { return x == FLT_MAX ? std::nextafter(x, 0.0f) : std::nextafter(x, INFINITY); }
 
 // A positive magnitude over float's whole range or a usual one, or one of the ends.
 float magnitude(Rng& rng) {
@@ -195,14 +197,14 @@ FogSettings draw_settings(const Shape& shape, Rng& rng, float color_limit) {
         h.extinction = ext;
         if (!(f & kHeightSameIn)) {
           glm::vec3 in(coin(rng, 0.3) ? 0.0f : magnitude(rng), magnitude(rng), coin(rng, 0.3) ? 0.0f : magnitude(rng));
-          if (in == ext) in.y = std::nextafter(in.y, INFINITY);
+          if (in == ext) in.y = beside(in.y);
           h.inscattering = in;
         }
       } else if (!(f & kHeightSameIn)) {
         float g = coin(rng, 0.2) ? 0.0f : magnitude(rng);
-        if (g == s.density) g = std::nextafter(g, INFINITY);
+        if (g == s.density) g = beside(g);
         h.inscattering = glm::vec3(g);
-        if (f & kHeightSun && g == 0.0f) h.inscattering = glm::vec3(std::nextafter(s.density, INFINITY));
+        if (f & kHeightSun && g == 0.0f) h.inscattering = glm::vec3(beside(s.density));
       }
       if (f & kHeightFalloff) h.falloff = signed_magnitude(rng);
       h.base_height = coin(rng, 0.2) ? signed_magnitude(rng) : float(200 * unit(rng) - 100);
