@@ -78,7 +78,7 @@ if want tests; then
   echo "tests: fogcl_tests with FOGCL_DEVICE=gpu in $shards shards"
   start=$(date +%s)
   for i in $(seq 0 $((shards - 1))); do
-    FOGCL_DEVICE=gpu FOGCL_TEST_CLI="$bin/fogcl" FOGCL_TEST_CUDA_INTEROP="$bin/fogcl_cuda_interop" FOGCL_TEST_CALL_GATE="$bin/fogcl_call_gate.so" FOGCL_TEST_DIR="$scratch/tests" GTEST_TOTAL_SHARDS=$shards \
+    FOGCL_DEVICE=gpu FOGCL_TEST_CLI="$bin/fogcl" FOGCL_TEST_CUDA_INTEROP="$bin/fogcl_cuda_interop" FOGCL_TEST_VULKAN_EXPORTER="$bin/fogcl_vulkan_exporter" FOGCL_TEST_CALL_GATE="$bin/fogcl_call_gate.so" FOGCL_TEST_DIR="$scratch/tests" GTEST_TOTAL_SHARDS=$shards \
       GTEST_SHARD_INDEX=$i timeout "${GPU_TEST_TIMEOUT:-540}" "$bin/fogcl_tests" \
       --gtest_output="xml:$results/tests-$i.xml" >"$results/tests-$i.log" 2>&1 &
   done
@@ -100,8 +100,8 @@ if want bench; then
   FOGCL_DEVICE=gpu bench fogcl_volume_bench volume-gpu.json 'BM_VolumeDevice|BM_VolumeHostCall|BM_VolumeNothingVisible' \
     --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
   bench fogcl_volume_bench volume-scalar.json 'BM_VolumeScalar'
-  echo "bench: a CUDA producer's frame fogged in its memory, signal to signal"
-  FOGCL_DEVICE=gpu bench fogcl_interop_bench interop-gpu.json 'BM_ExternalSignalToSignal'
+  echo "bench: a CUDA or Vulkan producer's frame fogged in its memory, signal to signal"
+  FOGCL_DEVICE=gpu bench fogcl_interop_bench interop-gpu.json 'BM_ExternalSignalToSignal|BM_VulkanSignalToSignal'
 fi
 
 # --- PoCL on every core: the volumetric march from 1 thread to all -----------------------------

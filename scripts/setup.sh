@@ -6,6 +6,7 @@ packages=(
   pocl-opencl-icd ocl-icd-opencl-dev opencl-c-headers opencl-clhpp-headers
   libglm-dev libimath-dev libopenexr-dev libpng-dev libcli11-dev nlohmann-json3-dev pkg-config
   libgtest-dev libbenchmark-dev
+  libvulkan-dev  # examples/vulkan_exporter.cpp and the Vulkan rows of the interop bench
   python3-matplotlib
 )
 # --sanitizers: also clang and its runtimes (libFuzzer, ASan, UBSan) for `make asan-test` / `make fuzz`.

@@ -5,6 +5,7 @@
 // These run on the GPU machine (scripts/gpu-run.sh); elsewhere they skip saying why, except the
 // refusal of a device without the extension, which CI's PoCL runs.
 #include <fcntl.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -460,6 +461,32 @@ TEST(GpuInterop, CudaInteropExampleRuns) {
   const int status = pclose(p);
   EXPECT_EQ(status, 0) << out;
   std::printf("%s", out.c_str());
+}
+
+// examples/vulkan_exporter.cpp, as an integrator would run it, on every machine: exit status 0 (its
+// frame equal to FogPass::apply's) where an OpenCL device imports opaque-fd memory and a Vulkan
+// device on the same GPU exports it; elsewhere (CI's PoCL imports none) the example exits 77 and
+// says why, which is a skip here, and any other status a failure.
+TEST(ExternalInterop, VulkanExporterExampleRuns) {
+  FOGCL_REQUIRE_DEVICE();
+#ifndef FOGCL_VULKAN_EXPORTER_PATH
+  GTEST_SKIP() << "built without the Vulkan headers and loader (libvulkan-dev): no vulkan_exporter";
+#else
+  const char* bundled = std::getenv("FOGCL_TEST_VULKAN_EXPORTER");  // scripts/gpu-run.sh's bundle
+  const std::string cmd = std::string(bundled != nullptr ? bundled : FOGCL_VULKAN_EXPORTER_PATH) + " 2>&1";
+  restore_start_opencl_env();
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  std::string out;
+  char buf[512];
+  while (std::fgets(buf, sizeof buf, p) != nullptr) out += buf;
+  const int status = pclose(p);
+  std::printf("%s", out.c_str());
+  ASSERT_TRUE(WIFEXITED(status)) << "vulkan_exporter did not exit (status " << status << "):\n" << out;
+  if (WEXITSTATUS(status) == 77) GTEST_SKIP() << out;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << out;
+  EXPECT_NE(out.find("equal bit for bit"), std::string::npos) << out;
+#endif
 }
 
 }  // namespace

@@ -6,8 +6,8 @@
 #  3. configure examples/ against the prefix (the io component too) with the build's compiler and
 #     flags (sanitizer builds link their instrumented library): no CMake warning; build it;
 #  4. run own_renderer (fog on host images: OpenCL against the scalar path), integrate (its fogged
-#     frame must equal the convenience API's, bit for bit) and fog_to_exr (EXR written through
-#     fogcl::io and read back);
+#     frame must equal the convenience API's, bit for bit), fog_to_exr (EXR written through
+#     fogcl::io and read back) and vulkan_exporter (0, or 77: skipped, saying why);
 #  5. fogcl::io linked without COMPONENTS io: configuring fails, saying to add it;
 #  6. own_renderer and fog_to_exr built from `pkg-config --cflags --libs fogcl` / `fogcl-io`
 #     alone, silently, and run;
@@ -54,7 +54,7 @@ foreach(tool_header report.h volume_report.h demo_scene.h)
     message(FATAL_ERROR "fogcl/${tool_header} is installed, but its library (the CLI's) is not")
   endif()
 endforeach()
-foreach(example own_renderer.cpp fog_to_exr.cpp integrate.cpp CMakeLists.txt)
+foreach(example own_renderer.cpp fog_to_exr.cpp integrate.cpp vulkan_exporter.cpp vulkan_producer.h CMakeLists.txt)
   if(NOT EXISTS ${prefix}/share/doc/fogcl/examples/${example})
     message(FATAL_ERROR "share/doc/fogcl/examples/${example} is not installed")
   endif()
@@ -102,6 +102,18 @@ endif()
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build -j 2)
 run(${WORK_DIR}/build/own_renderer)
 run(${WORK_DIR}/build/integrate 320 180)
+# vulkan_exporter where the Vulkan headers and loader are (scripts/setup.sh installs them): its frame
+# equal to FogPass::apply's (0), or skipped saying why (77: no OpenCL device that imports GPU
+# memory, as PoCL); anything else fails.
+if(EXISTS ${WORK_DIR}/build/vulkan_exporter)
+  execute_process(COMMAND ${WORK_DIR}/build/vulkan_exporter RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  message("$ vulkan_exporter\n${out}")
+  if(NOT (rc EQUAL 0 OR rc EQUAL 77))
+    message(FATAL_ERROR "vulkan_exporter failed (${rc})")
+  endif()
+else()
+  message("vulkan_exporter not built: no Vulkan headers and loader (libvulkan-dev)")
+endif()
 file(MAKE_DIRECTORY ${WORK_DIR}/exr-cmake)
 run(${WORK_DIR}/build/fog_to_exr ${WORK_DIR}/exr-cmake)
 
