@@ -15,11 +15,13 @@
 //            shorter, as Vulkan's own round trip, what 2, may be); 1 fogcl's side is enqueued once the host has seen
 //            the "ready" batch complete (its fence): the OpenCL wait finds the semaphore already
 //            signalled, and the figure includes the host's wake-up and enqueue
+//   BM_VulkanReadyAlreadySignalled  OpenCL's wait on a semaphore already signalled (its comment).
 // Without a Vulkan device on the OpenCL device's GPU that exports memory and semaphores, or an
 // OpenCL device that imports both, the rows report why they were skipped.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -275,6 +277,51 @@ BENCHMARK(BM_VulkanSignalToSignal)
     ->Args({1920, 1080, 1, 1, 0})
     ->Args({1920, 1080, 1, 1, 1})
     ->Args({1920, 1080, 1, 2, 0})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(200);
+
+// OpenCL's wait on a "ready" that has already been signalled (Vulkan's batch has completed: its
+// fence), on the host clock: from enqueueing the wait and a marker to the marker's event
+// complete (clWaitForEvents). wait 0: the marker alone, the same host round trip without the
+// wait; the difference is the wait's own cost when there is nothing to wait for.
+void BM_VulkanReadyAlreadySignalled(benchmark::State& state) {
+  VulkanInterop& x = vulkan_interop();
+  if (!x.why_not.empty()) {
+    state.SkipWithError(("no Vulkan interop: " + x.why_not).c_str());
+    return;
+  }
+  const bool wait = state.range(0) != 0;
+  cl_platform_id platform = nullptr;
+  clGetDeviceInfo(x.runtime->device(), CL_DEVICE_PLATFORM, sizeof platform, &platform, nullptr);
+  const auto wait_fn = reinterpret_cast<clEnqueueWaitSemaphoresKHR_fn>(
+      clGetExtensionFunctionAddressForPlatform(platform, "clEnqueueWaitSemaphoresKHR"));
+  const cl_command_queue queue = x.runtime->queue();
+  const cl_semaphore_khr ready = x.fog_ready->handle();
+  const VkFence signalled = x.vulkan.fence();
+  auto one = [&] {
+    if (wait) {
+      vkp::submit(x.vulkan.queue(), VK_NULL_HANDLE, {}, {x.ready}, signalled);
+      x.vulkan.wait(signalled);
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    if (wait) wait_fn(queue, 1, &ready, nullptr, 0, nullptr, nullptr);
+    cl_event marker = nullptr;
+    clEnqueueMarkerWithWaitList(queue, 0, nullptr, &marker);
+    clFlush(queue);
+    clWaitForEvents(1, &marker);
+    const auto t1 = std::chrono::steady_clock::now();
+    clReleaseEvent(marker);
+    return std::chrono::duration<double>(t1 - t0).count();
+  };
+  for (int i = 0; i < 3; ++i) one();
+  for (auto _ : state) state.SetIterationTime(one());
+}
+
+BENCHMARK(BM_VulkanReadyAlreadySignalled)
+    ->ArgName("wait")
+    ->Arg(0)
+    ->Arg(1)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(200);

@@ -9,6 +9,9 @@
 #   bench  both benchmarks on the GPU (device-resident and host round trip, the device copy, the
 #          pinned and pageable transfer of a round trip's bytes in the round trip's run)
 #   pocl   the volumetric march on the machine's PoCL, 1 to all cores (POCL_MAX_PTHREAD_COUNT)
+#   interop  a GPU renderer's frame where it lies, alone (not in "all"; tests and bench hold it
+#          too): the interop tests, examples/vulkan_exporter.cpp at three sizes, and every row of
+#          the interop bench (CUDA and Vulkan producers)
 #   sequence  fogcl apply on frame sequences against OpenEXR alone (sequence_bench.py; not in
 #          "all": minutes of I/O; SEQUENCE_ARGS adds its options, e.g. "--cases 4k-half-zip")
 # and writes RESULTS_DIR/summary.md from what they left (gpu_summary.py).
@@ -72,14 +75,16 @@ if [ "${parts[0]}" = exec ]; then
 fi
 
 # --- The whole suite on the GPU ------------------------------------------------------------------
+mkdir -p "$scratch/tests"
+test_env=(FOGCL_DEVICE=gpu FOGCL_TEST_CLI="$bin/fogcl" FOGCL_TEST_CUDA_INTEROP="$bin/fogcl_cuda_interop"
+          FOGCL_TEST_VULKAN_EXPORTER="$bin/fogcl_vulkan_exporter" FOGCL_TEST_CALL_GATE="$bin/fogcl_call_gate.so"
+          FOGCL_TEST_DIR="$scratch/tests")
 if want tests; then
   shards=${GPU_TEST_SHARDS:-8}
-  mkdir -p "$scratch/tests"
   echo "tests: fogcl_tests with FOGCL_DEVICE=gpu in $shards shards"
   start=$(date +%s)
   for i in $(seq 0 $((shards - 1))); do
-    FOGCL_DEVICE=gpu FOGCL_TEST_CLI="$bin/fogcl" FOGCL_TEST_CUDA_INTEROP="$bin/fogcl_cuda_interop" FOGCL_TEST_VULKAN_EXPORTER="$bin/fogcl_vulkan_exporter" FOGCL_TEST_CALL_GATE="$bin/fogcl_call_gate.so" FOGCL_TEST_DIR="$scratch/tests" GTEST_TOTAL_SHARDS=$shards \
-      GTEST_SHARD_INDEX=$i timeout "${GPU_TEST_TIMEOUT:-540}" "$bin/fogcl_tests" \
+    env "${test_env[@]}" GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$i timeout "${GPU_TEST_TIMEOUT:-540}" "$bin/fogcl_tests" \
       --gtest_output="xml:$results/tests-$i.xml" >"$results/tests-$i.log" 2>&1 &
   done
   wait
@@ -114,6 +119,22 @@ if want pocl; then
       'BM_VolumeDevice/integrator:[01]/divisor:2/noise_image:0/width:1920' --benchmark_repetitions=3 \
       --benchmark_report_aggregates_only=true
   done
+fi
+
+# --- A GPU renderer's frame where it lies ------------------------------------------------------
+if [ "${parts[0]}" = interop ]; then
+  echo "interop: the interop tests, the Vulkan exporter example, the hand-over rows"
+  env "${test_env[@]}" timeout 300 "$bin/fogcl_tests" --gtest_filter='GpuInterop*:ExternalInterop*' \
+    >"$results/interop-tests.txt" 2>&1 || { echo "interop: tests failed (see interop-tests.txt)"; status=1; }
+  for size in "" "1920 1080" "3840 2160"; do
+    echo "\$ vulkan_exporter $size"
+    # shellcheck disable=SC2086
+    FOGCL_DEVICE=gpu timeout 120 "$bin/fogcl_vulkan_exporter" $size
+    code=$?
+    echo "exit status $code"
+    [ $code -eq 0 ] || status=1
+  done >"$results/vulkan-exporter.txt" 2>&1
+  FOGCL_DEVICE=gpu bench fogcl_interop_bench interop-gpu.json '.'
 fi
 
 # --- Frame sequences: OpenEXR alone against fogcl apply, N threads pinned to N cores ----------

@@ -238,6 +238,12 @@ if inter:
               f'| {orders.get(a["order"], "?")} | {b["median_ms"]:.4f} | {b["pass_ms"]:.4f} | {over:.1f} | {verdict} |')
         p()
     for b in inter:
+        if b["base"].startswith("BM_VulkanReadyAlreadySignalled/") and "error_message" not in b:
+            what = "OpenCL waits, then a marker" if args(b["base"])["wait"] == "1" else "a marker alone"
+            p(f'- a "ready" Vulkan has already signalled, host clock to the marker\'s event: {what}: '
+              f'{ms(b) * 1e3:.1f} µs')
+    p()
+    for b in inter:
         a = args(b["base"])
         whole = a.get("what", "0") == "0" and a.get("order", "0") == "0"
         if "over_pass_us" in b and b["over_pass_us"] > 50 and whole:
