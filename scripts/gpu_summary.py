@@ -214,7 +214,7 @@ if inter:
              "5": "OpenCL signals alone", "6": "part 1 on a queue without profiling",
              "7": "OpenCL waits, then writes a counter CUDA waits for (no OpenCL signal)"}
     for b in inter:
-        if b["base"].startswith("BM_ExternalHandOverParts/"):
+        if b["base"].startswith("BM_ExternalHandOverParts/") and "error_message" not in b:
             part = args(b["base"])["part"]
             p(f'- hand-over part {part}, {parts.get(part, "?")} (1080p f16): {ms(b) * 1e3:.1f} µs')
     p()
