@@ -66,7 +66,7 @@ class Producer {
     auto ici = make<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
     ici.pApplicationInfo = &app;
     if (VkResult r = vkCreateInstance(&ici, nullptr, &instance_); r != VK_SUCCESS)
-      return "vkCreateInstance failed (VkResult " + std::to_string(r) + "): no Vulkan 1.2 driver";
+      return "vkCreateInstance failed (VkResult " + std::to_string(r) + "): no Vulkan driver";
     std::uint32_t count = 0;
     vkEnumeratePhysicalDevices(instance_, &count, nullptr);
     std::vector<VkPhysicalDevice> devices(count);
