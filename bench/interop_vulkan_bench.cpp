@@ -8,6 +8,10 @@
 //     what   0 the whole ExternalFrame::enqueue (wait, acquire, deferred pass, release, signal);
 //            1 OpenCL waits and signals, nothing between; 2 no OpenCL: Vulkan waits for its own
 //            "ready" (its semaphore round trip)
+//     vol    0 the deferred pass (exp2); 1 the fog volumes (VolumePass, the demo scene's volumes
+//            on its frame, default settings), whose target is a ratio: signal to signal <= 1.1x
+//            the pass's device time (counter ratio; pass_ms from a marker before the march to the
+//            composite's end)
 //     order  0 fogcl's side is enqueued before Vulkan's signal runs: a timeline semaphore that
 //            the host signals holds Vulkan's queue until then, so the figure is the GPU's
 //            hand-over, not the host's enqueue (the batch waiting for "done" is submitted just
@@ -28,6 +32,7 @@
 #include <vector>
 
 #include "../examples/vulkan_producer.h"
+#include "fogcl/demo_scene.h"
 #include "fogcl/external_memory.h"
 #include "fogcl/fogcl.h"
 
@@ -100,7 +105,7 @@ VulkanInterop& vulkan_interop() {
 }
 
 // A w x h frame in two exportable Vulkan buffers (color, depth), imported and bound, a prepared
-// exp2 pass for it, and the two command buffers around the hand-over:
+// exp2 pass or fog-volume pass for it, and the two command buffers around the hand-over:
 //   start: release the buffers to the external API, timestamp 0 (then the batch signals "ready")
 //   stop:  (after the wait for "done", which holds every stage) timestamp 1, acquire the buffers back
 struct VulkanFrame {
@@ -108,30 +113,46 @@ struct VulkanFrame {
   std::unique_ptr<ExternalMemory> color_memory, depth_memory;
   std::unique_ptr<ExternalFrame> frame;
   std::unique_ptr<FogPass> pass;
+  std::unique_ptr<VolumePass> volume;  // instead of pass
   CameraParams camera;
   FogSettings settings;  // exp2, as BM_ExternalSignalToSignal's
+  VolumeScene scene;
+  VolumeSettings volume_settings;
   VkCommandBuffer start = VK_NULL_HANDLE, stop = VK_NULL_HANDLE;
   VkFence started = VK_NULL_HANDLE, stopped = VK_NULL_HANDLE;
   std::string why_not;
 
-  VulkanFrame(VulkanInterop& x, int w, int h, ColorFormat format) {
+  VulkanFrame(VulkanInterop& x, int w, int h, ColorFormat format, bool volumes) {
     const cl_context context = x.runtime->context();
     const cl_device_id device = x.runtime->device();
     vkp::Producer& vk = x.vulkan;
     const std::size_t color_bytes = color_buffer_bytes(w, h, format), depth_bytes = depth_buffer_bytes(w, h);
     if (!(why_not = vk.exportable_buffer(color_bytes, color)).empty()) return;
     if (!(why_not = vk.exportable_buffer(depth_bytes, depth)).empty()) return;
-    // Sky and a depth ramp (the pass's time does not depend on the pixels' values).
+    // The deferred pass: sky and a depth ramp (its time does not depend on the pixels' values);
+    // the volumes: the demo scene, whose depth decides where the march stops.
     PerspectiveCamera lens;
     lens.aspect = float(w) / float(h);
     camera = make_camera_params(lens);
     ColorImage c(w, h, format);
     DepthImage d(w, h);
-    for (int y = 0; y < h; ++y)
-      for (int px = 0; px < w; ++px) {
-        c.set_pixel(px, y, {0.3f, 0.5f, 0.8f, 1.0f});
-        d.at(px, y) = y < h / 3 ? 1.0f : float(y) / float(h);
-      }
+    if (volumes) {
+      DemoFrame demo = render_demo_scene(w, h, lens, {}, format);
+      c = std::move(demo.color);
+      d = std::move(demo.depth);
+      camera = demo.params;
+      const DemoView view;
+      scene.pose.eye = view.eye;
+      scene.pose.forward = view.target - view.eye;
+      scene.light = demo_light();
+      scene.volumes = demo_fog_volumes(volume_settings.integrator);
+    } else {
+      for (int y = 0; y < h; ++y)
+        for (int px = 0; px < w; ++px) {
+          c.set_pixel(px, y, {0.3f, 0.5f, 0.8f, 1.0f});
+          d.at(px, y) = y < h / 3 ? 1.0f : float(y) / float(h);
+        }
+    }
     const vkp::Buffer staging = vk.host_buffer(color_bytes + depth_bytes);
     std::memcpy(staging.mapped, c.data(), color_bytes);
     std::memcpy(static_cast<unsigned char*>(staging.mapped) + color_bytes, d.data(), depth_bytes);
@@ -168,9 +189,48 @@ struct VulkanFrame {
     layout.color_in = {color_memory.get(), 0, 0};
     layout.depth = {depth_memory.get(), 0, 0};
     frame = std::make_unique<ExternalFrame>(context, device, layout);
-    pass = std::make_unique<FogPass>(context, device);
-    settings.density = 0.002f;
-    pass->prepare(settings, camera, format);
+    if (volumes) {
+      volume = std::make_unique<VolumePass>(context, device);
+      volume->prepare(camera, scene, volume_settings, format);
+    } else {
+      pass = std::make_unique<FogPass>(context, device);
+      settings.density = 0.002f;
+      pass->prepare(settings, camera, format);
+    }
+  }
+
+  // fogcl's side of one frame on `queue`.
+  cl_event enqueue(cl_command_queue queue, const ExternalSync& sync) {
+    return volume ? frame->enqueue(*volume, queue, camera, scene, volume_settings, sync)
+                  : frame->enqueue(*pass, queue, camera, settings, sync);
+  }
+  // The pass's device time on the frame (acquired and released, no semaphores) on a profiling
+  // queue: the deferred kernel's start to end; the volumes' marker before the march to the
+  // composite's end (several kernels).
+  double device_seconds(cl_command_queue profiling) {
+    cl_event first = nullptr, last = nullptr;
+    const cl_event released = frame->enqueue(profiling, [&](const FrameBuffers& fb, const std::vector<cl_event>& w) {
+      if (volume) {
+        clEnqueueMarkerWithWaitList(profiling, cl_uint(w.size()), w.empty() ? nullptr : w.data(), &first);
+        last = volume->enqueue(profiling, fb, camera, scene, volume_settings, nullptr, {first});
+      } else {
+        last = pass->enqueue(profiling, fb, camera, settings, w);
+      }
+      clRetainEvent(last);
+      return last;
+    });
+    clWaitForEvents(1, &released);
+    clReleaseEvent(released);
+    cl_ulong t0 = 0, t1 = 0;
+    if (first != nullptr) {
+      clGetEventProfilingInfo(first, CL_PROFILING_COMMAND_END, sizeof t0, &t0, nullptr);
+      clReleaseEvent(first);
+    } else {
+      clGetEventProfilingInfo(last, CL_PROFILING_COMMAND_START, sizeof t0, &t0, nullptr);
+    }
+    clGetEventProfilingInfo(last, CL_PROFILING_COMMAND_END, sizeof t1, &t1, nullptr);
+    clReleaseEvent(last);
+    return double(t1 - t0) * 1e-9;
   }
 };
 
@@ -180,8 +240,7 @@ double hand_over(VulkanInterop& x, VulkanFrame& f, int what, int order) {
   const VkQueue q = vk.queue();
   auto consumer = [&] {
     if (what == 0) {
-      clReleaseEvent(f.frame->enqueue(*f.pass, x.runtime->queue(), f.camera, f.settings,
-                                      {{x.fog_ready.get()}, {x.fog_done.get()}, {}}));
+      clReleaseEvent(f.enqueue(x.runtime->queue(), {{x.fog_ready.get()}, {x.fog_done.get()}, {}}));
     } else if (what == 1) {
       cl_platform_id platform = nullptr;
       clGetDeviceInfo(x.runtime->device(), CL_DEVICE_PLATFORM, sizeof platform, &platform, nullptr);
@@ -231,7 +290,7 @@ void BM_VulkanSignalToSignal(benchmark::State& state) {
   }
   const ColorFormat format = state.range(2) != 0 ? ColorFormat::rgba16f : ColorFormat::rgba32f;
   const int what = int(state.range(3)), order = int(state.range(4));
-  VulkanFrame f(x, int(state.range(0)), int(state.range(1)), format);
+  VulkanFrame f(x, int(state.range(0)), int(state.range(1)), format, state.range(5) != 0);
   if (!f.why_not.empty()) {
     state.SkipWithError(f.why_not.c_str());
     return;
@@ -242,41 +301,28 @@ void BM_VulkanSignalToSignal(benchmark::State& state) {
     times.push_back(hand_over(x, f, what, order));
     state.SetIterationTime(times.back());
   }
-  // The deferred pass's kernel on the same frame (acquired and released, no semaphores).
   std::vector<double> pass_s;
-  for (int i = 0; i < 20; ++i) {
-    cl_event e = nullptr;
-    const cl_event last =
-        f.frame->enqueue(x.profiling_queue, [&](const FrameBuffers& fb, const std::vector<cl_event>& w) {
-          e = f.pass->enqueue(x.profiling_queue, fb, f.camera, f.settings, w);
-          clRetainEvent(e);
-          return e;
-        });
-    clWaitForEvents(1, &last);
-    clReleaseEvent(last);
-    cl_ulong t0 = 0, t1 = 0;
-    clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_START, sizeof t0, &t0, nullptr);
-    clGetEventProfilingInfo(e, CL_PROFILING_COMMAND_END, sizeof t1, &t1, nullptr);
-    clReleaseEvent(e);
-    pass_s.push_back(double(t1 - t0) * 1e-9);
-  }
+  for (int i = 0; i < 20; ++i) pass_s.push_back(f.device_seconds(x.profiling_queue));
   std::nth_element(pass_s.begin(), pass_s.begin() + 10, pass_s.end());
   std::nth_element(times.begin(), times.begin() + std::ptrdiff_t(times.size() / 2), times.end());
   state.counters["pass_ms"] = pass_s[10] * 1e3;
   state.counters["median_ms"] = times[times.size() / 2] * 1e3;
   state.counters["over_pass_us"] = (times[times.size() / 2] - pass_s[10]) * 1e6;
+  state.counters["ratio"] = times[times.size() / 2] / pass_s[10];
 }
 
 BENCHMARK(BM_VulkanSignalToSignal)
-    ->ArgNames({"w", "h", "f16", "what", "order"})
-    ->Args({1920, 1080, 0, 0, 0})
-    ->Args({1920, 1080, 1, 0, 0})
-    ->Args({3840, 2160, 0, 0, 0})
-    ->Args({3840, 2160, 1, 0, 0})
-    ->Args({1920, 1080, 1, 0, 1})
-    ->Args({1920, 1080, 1, 1, 0})
-    ->Args({1920, 1080, 1, 1, 1})
-    ->Args({1920, 1080, 1, 2, 0})
+    ->ArgNames({"w", "h", "f16", "what", "order", "vol"})
+    ->Args({1920, 1080, 0, 0, 0, 0})
+    ->Args({1920, 1080, 1, 0, 0, 0})
+    ->Args({3840, 2160, 0, 0, 0, 0})
+    ->Args({3840, 2160, 1, 0, 0, 0})
+    ->Args({1920, 1080, 1, 0, 1, 0})
+    ->Args({1920, 1080, 1, 1, 0, 0})
+    ->Args({1920, 1080, 1, 1, 1, 0})
+    ->Args({1920, 1080, 1, 2, 0, 0})
+    ->Args({1920, 1080, 1, 0, 0, 1})
+    ->Args({3840, 2160, 1, 0, 0, 1})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(200);
