@@ -234,9 +234,15 @@ if inter:
                 continue
             over = b["over_pass_us"]
             volumes = a.get("vol") == "1"
-            met = b["ratio"] <= 1.1 if volumes else over <= 50
-            verdict = (("met" if met else "FAILED") + (f' ({b["ratio"]:.2f}x)' if volumes else "")
-                       if a["what"] == "0" and a["order"] == "0" else "(a part)")
+            # The volumes' pass_ms may include the host's enqueue (interop_vulkan_bench.cpp): their
+            # ratio is a lower bound, which can fail the target but not meet it.
+            if a["what"] != "0" or a["order"] != "0":
+                verdict = "(a part)"
+            elif volumes:
+                verdict = (f'FAILED ({b["ratio"]:.2f}x)' if b["ratio"] > 1.1 else
+                           f'undecided (>= {b["ratio"]:.2f}x: the pass time may include the host\'s enqueue)')
+            else:
+                verdict = "met" if over <= 50 else "FAILED"
             side = whats.get(a["what"], "?") + (", fog volumes" if volumes else ", deferred")
             p(f'| {a["w"]}x{a["h"]} | {"f16" if a["f16"] == "1" else "f32"} | {side} '
               f'| {orders.get(a["order"], "?")} | {b["median_ms"]:.4f} | {b["pass_ms"]:.4f} | {over:.1f} | {verdict} |')
