@@ -295,7 +295,10 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
       throw Error("--max-error must be a number >= 0 (got " + str(o.max_error) + ")");
   }
 
-  if (!o.volumes_path.empty()) s.volumes_ = read_volumes_json(o.volumes_path);
+  if (!o.volumes_text.empty())
+    s.volumes_ = parse_volumes_json(o.volumes_text, o.volumes_path);
+  else if (!o.volumes_path.empty())
+    s.volumes_ = read_volumes_json(o.volumes_path);
   for (FogVolume& v : s.volumes_) v = volume_to_fogcl(axes, v);
   s.runtime_ = runtime;
   if (runtime != nullptr) s.pass_ = std::make_unique<VolumePass>(*runtime);
