@@ -8,6 +8,8 @@ packages=(
   libgtest-dev libbenchmark-dev
   python3-matplotlib
 )
+# PyOpenCL, for the Python module's passes on a PyOpenCL context (tests/python/test_integration.py).
+packages+=(python3-pyopencl)
 # --sanitizers: also clang and its runtimes (libFuzzer, ASan, UBSan) for `make asan-test` / `make fuzz`.
 if [ "${1:-}" = "--sanitizers" ]; then
   packages+=(clang-14 libclang-rt-14-dev)
