@@ -123,7 +123,8 @@ struct FrameSetup {
 // fogcl.apply's options that choose a device or measure one: a pass runs on its context's.
 constexpr const char* kNotPassOptions[] = {"device", "host_transfer", "max_memory", "max_error"};
 
-FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const std::string& who) {
+// with_volumes: the volume stage too (VolumePass); a FogPass leaves the volume options alone.
+FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const std::string& who, bool with_volumes) {
   for (const char* key : kNotPassOptions)
     if (kwargs.contains(key))
       throw py::value_error(who + ": " + key + "= is fogcl.apply's (it opens or measures a device); a pass runs on "
@@ -140,7 +141,7 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
   cam.reversed_z = o.reversed_z;
   s.camera = make_camera_params(cam);
   s.camera.depth_kind = parse_depth_kind(o.depth_kind);
-  s.volumes = cli::VolumeStage::create(o.volumes, nullptr);
+  if (with_volumes) s.volumes = cli::VolumeStage::create(o.volumes, nullptr);
   return s;
 }
 
@@ -203,7 +204,7 @@ class PyFogPass : public PassObject<FogPass> {
   void prepare(int width, int height, const std::string& format, const py::kwargs& options) {
     const ColorFormat storage = parse_format(format);
     check_size(width, height, who() + ".prepare");
-    const FrameSetup setup = frame_setup(options, width, height, who() + ".prepare");
+    const FrameSetup setup = frame_setup(options, width, height, who() + ".prepare", false);
     locked("prepare", [&](FogPass& pass, PassHandles&) { pass.prepare(setup.settings, setup.camera, storage); });
   }
 
@@ -215,7 +216,7 @@ class PyFogPass : public PassObject<FogPass> {
     const FrameBuffers fb = frame_buffers(h, color, depth, out, width, height, parse_format(format), who);
     const cl::CommandQueue q = h.queue_for(queue, who);
     const std::vector<cl_event> waits = wait_list(wait_for, h.context, who);
-    const FrameSetup setup = frame_setup(options, width, height, who);
+    const FrameSetup setup = frame_setup(options, width, height, who, false);
     return adopt_event(locked("enqueue", [&](FogPass& pass, PassHandles&) {
       return pass.enqueue(q(), fb, setup.camera, setup.settings, waits);
     }));
@@ -230,7 +231,7 @@ class PyVolumePass : public PassObject<VolumePass> {
   void prepare(int width, int height, const std::string& format, const py::kwargs& options) {
     const ColorFormat storage = parse_format(format);
     check_size(width, height, who() + ".prepare");
-    const FrameSetup setup = frame_setup(options, width, height, who() + ".prepare");
+    const FrameSetup setup = frame_setup(options, width, height, who() + ".prepare", true);
     const cli::VolumeStage& stage = volumes_of(setup, "prepare");
     const VolumeScene scene = stage.scene_for(-1);
     locked("prepare", [&](VolumePass& pass, PassHandles&) {
@@ -246,7 +247,7 @@ class PyVolumePass : public PassObject<VolumePass> {
     const FrameBuffers fb = frame_buffers(h, color, depth, out, width, height, parse_format(format), who);
     const cl::CommandQueue q = h.queue_for(queue, who);
     const std::vector<cl_event> waits = wait_list(wait_for, h.context, who);
-    const FrameSetup setup = frame_setup(options, width, height, who);
+    const FrameSetup setup = frame_setup(options, width, height, who, true);
     const cli::VolumeStage& stage = volumes_of(setup, "enqueue");
     const VolumeScene scene = stage.scene_for(-1);
     return adopt_event(locked("enqueue", [&](VolumePass& pass, PassHandles& handles) {
