@@ -99,8 +99,15 @@ class VolumeStage {
   // (and a frame of another storage) picks the variant for its storage.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
              int sequence_frame, bool verbose);
+  // The same over the caller's memory (a frame in memory: the Python module).
+  void apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out, const CameraParams& camera,
+             int sequence_frame, bool verbose);
 
  private:
+  template <class In, class Depth, class Out>
+  void apply_frame(const In& in, const Depth& depth, Out& out, const CameraParams& camera, int sequence_frame,
+                   bool verbose);
+
   VolumeCliOptions options_;
   std::vector<FogVolume> volumes_;
   CameraPose pose_;

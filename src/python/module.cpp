@@ -30,5 +30,8 @@ PYBIND11_MODULE(_fogcl, m) {
   });
   m.def("version", [] { return std::string(fogcl::library_version()); },
         "The version of the fogcl library the module is built with, e.g. '0.1.0'.");
+  fogcl::python::bind_frames(m);
+  fogcl::python::bind_exr(m);
+  fogcl::python::bind_report(m);
   fogcl::python::bind_integration(m);
 }
