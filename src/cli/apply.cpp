@@ -238,14 +238,8 @@ FogSettings pass_settings(const ApplyOptions& o, Backend& backend, ColorFormat s
   return s;
 }
 
-// The camera of one frame (and the poses the volumes and height fog take from it), from the
-// options and the color file's header. text, pose_from, height_pose_from: for --verbose.
-struct FrameCamera {
-  CameraParams params;
-  std::string text;
-  std::optional<CameraPose> pose;  // for the volumes, when it comes with the frame (cli/camera_cli.h)
-  std::string pose_from, height_pose_from;
-};
+// The camera of one frame (cli/memory_frame.h's FrameCamera) from the options and the color file's
+// header.
 FrameCamera frame_camera_setup(const ApplyOptions& o, const ExrInput& color) {
   const DepthKind kind = parse_depth_kind(o.depth_kind);
   FrameCamera c;
@@ -859,15 +853,20 @@ MemoryFogger::~MemoryFogger() = default;
 Backend& MemoryFogger::backend() { return devices_->devices.backend; }
 VolumeStage* MemoryFogger::volumes() { return devices_->devices.volumes.get(); }
 
+FrameCamera memory_frame_camera(const ApplyOptions& o, int width, int height, const ExrCamera* camera,
+                                const std::string& name) {
+  // What the frame code reads of a file besides its pixels: its name, size and camera.
+  ExrInput header;
+  header.path = name;
+  header.windows.display_max = header.windows.data_max = glm::ivec2(width - 1, height - 1);
+  if (camera != nullptr) header.camera = *camera;
+  return frame_camera_setup(o, header);
+}
+
 void MemoryFogger::fog(const MemoryFrame& f) {
   const ApplyOptions& o = options_;
   validate_frame(f.color, f.depth, f.out);
-  // What the frame code reads of a file besides its pixels: its name, size and camera.
-  ExrInput header;
-  header.path = f.name;
-  header.windows.display_max = header.windows.data_max = glm::ivec2(f.color.width() - 1, f.color.height() - 1);
-  if (f.camera != nullptr) header.camera = *f.camera;
-  const FrameCamera camera = frame_camera_setup(o, header);
+  const FrameCamera camera = memory_frame_camera(o, f.color.width(), f.color.height(), f.camera, f.name);
   const CameraParams& params = camera.params;
   Backend& backend = devices_->devices.backend;
   if (backend.runtime() != nullptr)

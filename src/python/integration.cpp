@@ -11,8 +11,8 @@
 #include <utility>
 #include <vector>
 
+#include "cli/memory_frame.h"
 #include "cli/volumes_cli.h"
-#include "fogcl/depth_kinds.h"
 #include "fogcl/fog_pass.h"
 #include "fogcl/volume_pass.h"
 #include "python/bindings.h"
@@ -130,18 +130,16 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
       throw py::value_error(who + ": " + key + "= is fogcl.apply's (it opens or measures a device); a pass runs on "
                             "its context's device with the options' precision and volume settings");
   const cli::ApplyOptions o = apply_options(kwargs);
+  cli::check_apply_options(o);
+  // No file behind the frame: the camera is the options' alone (--fov, --ortho-size or the lens).
+  const cli::FrameCamera camera = cli::memory_frame_camera(o, width, height, nullptr, "the frame");
   FrameSetup s;
+  s.camera = camera.params;
   s.settings = o.settings;
-  // TEMPORARY (development): the camera from --fov alone.
-  PerspectiveCamera cam;
-  cam.fov_y_deg = o.fov;
-  cam.aspect = float(width) / float(height);
-  cam.near_plane = o.near_plane;
-  cam.far_plane = o.far_plane;
-  cam.reversed_z = o.reversed_z;
-  s.camera = make_camera_params(cam);
-  s.camera.depth_kind = parse_depth_kind(o.depth_kind);
-  if (with_volumes) s.volumes = cli::VolumeStage::create(o.volumes, nullptr);
+  if (with_volumes) {
+    s.volumes = cli::VolumeStage::create(o.volumes, nullptr);
+    if (s.volumes) s.volumes->set_frame_pose(camera.pose, camera.pose_from);
+  }
   return s;
 }
 
