@@ -30,3 +30,9 @@ def report(width=640, height=360, runs=9, device=""):
     dev, driver, rows = _report_rows(int(width), int(height), int(runs), str(device))
     dtype = _np.dtype(REPORT_DTYPE, metadata={"device": dev, "driver": driver})
     return _np.array(rows, dtype=dtype)
+
+
+# The passes on a PyOpenCL context, queue and buffers (docs/python.md, "On your PyOpenCL context").
+from ._fogcl import FogPass, VolumePass  # noqa: E402,F401
+
+__all__ += ["FogPass", "VolumePass"]
