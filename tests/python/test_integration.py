@@ -148,6 +148,31 @@ def test_volume_pass_equals_apply_bit_for_bit(ctx, queue, seed):
     assert np.any(got != color), "the volumes changed no pixel: the test would not see a wrong pass"
 
 
+def test_volume_pass_with_a_shadow_map(ctx, queue, tmp_path):
+    """shadow_map= (a file, as fogcl.apply reads it) goes to the device with the frame: the same
+    bits as fogcl.apply, and not those of the frame without it."""
+    rng = np.random.default_rng(2500)
+    width, height = 48, 32
+    color, depth = frame(rng, width, height)
+    fogcl.write_exr_depth(str(tmp_path / "shadow.exr"), rng.uniform(0.0, 0.35, (24, 20)).astype(np.float32))
+    # An orthographic light above the volumes looking down: x / 10, (z - 6) / 8, depth (5 - y) / 15.
+    light = [0.1, 0, 0, 0, 0, 0, 0.125, -0.75, 0, -1 / 15, 0, 1 / 3, 0, 0, 0, 1]
+    document = volumes_document(rng, 2)
+    lit = dict(VOLUME_OPTIONS, volumes=document, mode="off")
+    options = dict(lit, shadow_map=tmp_path / "shadow.exr", light_view_proj=light)
+    want = fogcl.apply(color, depth, **options)
+
+    volumes = fogcl.VolumePass(ctx, queue=queue)
+    volumes.prepare(width, height, **options)
+    c, d, o = to_device(ctx, color), to_device(ctx, depth), to_device(ctx, np.zeros_like(color))
+    event = volumes.enqueue(c, d, o, width=width, height=height, **options)
+    got = from_device(queue, o, color, wait_for=[event])
+    assert report_bits("VolumePass with a shadow map", got, want) == 0
+    unshadowed = fogcl.apply(color, depth, **lit)
+    print(f"  the shadow changes the frame by up to {np.abs(want - unshadowed).max():.3g}")
+    assert np.any(got != unshadowed)
+
+
 CHAINED_CASES = {
     "volumes": lambda rng: dict(VOLUME_OPTIONS, volumes=volumes_document(rng, 2), mode="exp2", density=0.05),
     # The height fog marched with the volumes (the deferred pass then runs none of it).
