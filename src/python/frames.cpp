@@ -19,8 +19,8 @@ namespace fogcl::python {
 
 namespace {
 
-// `fogcl apply` flags that name files or how they are written: fogcl.apply takes arrays and returns
-// one (fogcl.read_exr and fogcl.write_exr take these choices).
+// `fogcl apply` flags about files, sequences and the command's own output: fogcl.apply takes arrays
+// and returns one (fogcl.read_exr and fogcl.write_exr take the files' choices).
 const std::map<std::string, std::string> kFileOptions{
     {"color", "the color is the first argument"},
     {"depth", "the depth is the second argument"},
@@ -96,7 +96,7 @@ py::array apply(const py::array& color, const py::array& depth, const py::object
     const std::string key = py::str(item.first);
     if (auto it = kFileOptions.find(key); it != kFileOptions.end())
       throw py::value_error("fogcl.apply takes no " + key + "= (fogcl apply's --" + cli_flag_name(key) +
-                            " is about files): " + it->second);
+                            "): " + it->second);
   }
   const cli::ApplyOptions o = apply_options(options);
   const ConstColorView in = color_view(color, "color");
