@@ -5,6 +5,7 @@ import gc
 import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -229,6 +230,42 @@ def test_enqueue_waits_for_its_events(ctx, queue):
     event.wait()
     got = from_device(queue, o, color)
     assert report_bits("after the gate", got, fogcl.apply(color, depth, **options)) == 0
+
+
+def test_one_pass_shared_by_threads(ctx):
+    """Threads enqueue on one pass, each on its own queue with its own settings: the pass takes one
+    call at a time (its kernels carry arguments from setArg to the enqueue), so every frame is the
+    one fogcl.apply makes of its options."""
+    width, height = 40, 24
+    rng = np.random.default_rng(6000)
+    color, depth = frame(rng, width, height)
+    densities = [0.02, 0.05, 0.1, 0.3]
+    fog = fogcl.FogPass(ctx)
+    for density in densities:
+        fog.prepare(width, height, near=0.3, far=100.0, fov=60.0, mode="exp", density=density)
+    wants = [fogcl.apply(color, depth, near=0.3, far=100.0, fov=60.0, mode="exp", density=x) for x in densities]
+    differ = [0] * len(densities)
+    FRAMES = 60
+
+    def run(i):
+        # The frames are enqueued back to back, each into its own buffer, and read at the end: the
+        # threads' enqueues interleave as closely as they can.
+        queue = cl.CommandQueue(ctx)
+        c, d = to_device(ctx, color), to_device(ctx, depth)
+        outs = [cl.Buffer(ctx, cl.mem_flags.READ_WRITE, color.nbytes) for _ in range(FRAMES)]
+        events = [fog.enqueue(c, d, o, width=width, height=height, queue=queue, near=0.3, far=100.0, fov=60.0,
+                              mode="exp", density=densities[i]) for o in outs]
+        for o, event in zip(outs, events):
+            got = from_device(queue, o, color, wait_for=[event])
+            differ[i] += int(np.count_nonzero(got.view(np.uint32) != wants[i].view(np.uint32)))
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(len(densities))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    print(f"values differing from fogcl.apply per thread ({FRAMES} frames each):", differ)
+    assert differ == [0] * len(densities)
 
 
 def test_many_frames_leak_nothing(ctx):
