@@ -143,6 +143,15 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
   return s;
 }
 
+// An enqueue's arguments, checked before the pass runs.
+struct FrameCall {
+  PassHandles handles;  // retained: release() may come while the call runs
+  FrameBuffers buffers;
+  cl::CommandQueue queue;
+  std::vector<cl_event> waits;  // borrowed from wait_for's events
+  FrameSetup setup;
+};
+
 // A pass and its handles; release() (or the end of a with block) lets them go before the Python
 // object does. One call at a time: the C++ passes are not thread-safe, and the GIL is released
 // while they run.
@@ -187,6 +196,25 @@ class PassObject {
   }
   const std::string& who() const { return who_; }
 
+  // prepare's options for a width x height frame.
+  FrameSetup prepare_setup(int width, int height, const py::kwargs& options, bool with_volumes) {
+    check_size(width, height, who_ + ".prepare");
+    return frame_setup(options, width, height, who_ + ".prepare", with_volumes);
+  }
+
+  // enqueue's arguments, each checked under its own name.
+  FrameCall frame_call(const py::object& color, const py::object& depth, const py::object& out, int width, int height,
+                       const std::string& format, const py::object& queue, const py::object& wait_for,
+                       const py::kwargs& options, bool with_volumes) {
+    const std::string who = who_ + ".enqueue";
+    PassHandles h = handles("enqueue");
+    const FrameBuffers fb = frame_buffers(h, color, depth, out, width, height, parse_format(format), who);
+    cl::CommandQueue q = h.queue_for(queue, who);
+    std::vector<cl_event> waits = wait_list(wait_for, h.context, who);
+    FrameSetup setup = frame_setup(options, width, height, who, with_volumes);
+    return {std::move(h), fb, std::move(q), std::move(waits), std::move(setup)};
+  }
+
  private:
   std::string who_;
   std::mutex m_;
@@ -201,22 +229,16 @@ class PyFogPass : public PassObject<FogPass> {
 
   void prepare(int width, int height, const std::string& format, const py::kwargs& options) {
     const ColorFormat storage = parse_format(format);
-    check_size(width, height, who() + ".prepare");
-    const FrameSetup setup = frame_setup(options, width, height, who() + ".prepare", false);
+    const FrameSetup setup = prepare_setup(width, height, options, false);
     locked("prepare", [&](FogPass& pass, PassHandles&) { pass.prepare(setup.settings, setup.camera, storage); });
   }
 
   py::object enqueue(const py::object& color, const py::object& depth, const py::object& out, int width, int height,
                      const std::string& format, const py::object& queue, const py::object& wait_for,
                      const py::kwargs& options) {
-    const std::string who = this->who() + ".enqueue";
-    const PassHandles h = handles("enqueue");
-    const FrameBuffers fb = frame_buffers(h, color, depth, out, width, height, parse_format(format), who);
-    const cl::CommandQueue q = h.queue_for(queue, who);
-    const std::vector<cl_event> waits = wait_list(wait_for, h.context, who);
-    const FrameSetup setup = frame_setup(options, width, height, who, false);
+    const FrameCall c = frame_call(color, depth, out, width, height, format, queue, wait_for, options, false);
     return adopt_event(locked("enqueue", [&](FogPass& pass, PassHandles&) {
-      return pass.enqueue(q(), fb, setup.camera, setup.settings, waits);
+      return pass.enqueue(c.queue(), c.buffers, c.setup.camera, c.setup.settings, c.waits);
     }));
   }
 };
@@ -228,8 +250,7 @@ class PyVolumePass : public PassObject<VolumePass> {
 
   void prepare(int width, int height, const std::string& format, const py::kwargs& options) {
     const ColorFormat storage = parse_format(format);
-    check_size(width, height, who() + ".prepare");
-    const FrameSetup setup = frame_setup(options, width, height, who() + ".prepare", true);
+    const FrameSetup setup = prepare_setup(width, height, options, true);
     const cli::VolumeStage& stage = volumes_of(setup, "prepare");
     const VolumeScene scene = stage.scene_for(-1);
     locked("prepare", [&](VolumePass& pass, PassHandles&) {
@@ -240,17 +261,12 @@ class PyVolumePass : public PassObject<VolumePass> {
   py::object enqueue(const py::object& color, const py::object& depth, const py::object& out, int width, int height,
                      const std::string& format, const py::object& queue, const py::object& wait_for,
                      const py::kwargs& options) {
-    const std::string who = this->who() + ".enqueue";
-    const PassHandles h = handles("enqueue");
-    const FrameBuffers fb = frame_buffers(h, color, depth, out, width, height, parse_format(format), who);
-    const cl::CommandQueue q = h.queue_for(queue, who);
-    const std::vector<cl_event> waits = wait_list(wait_for, h.context, who);
-    const FrameSetup setup = frame_setup(options, width, height, who, true);
-    const cli::VolumeStage& stage = volumes_of(setup, "enqueue");
+    const FrameCall c = frame_call(color, depth, out, width, height, format, queue, wait_for, options, true);
+    const cli::VolumeStage& stage = volumes_of(c.setup, "enqueue");
     const VolumeScene scene = stage.scene_for(-1);
     return adopt_event(locked("enqueue", [&](VolumePass& pass, PassHandles& handles) {
       // The light's depth map, read from its file by the options, goes to the device with this
-      // frame (copied at the buffer's creation; the buffer lives until the march has read it).
+      // frame (copied at the buffer's creation; OpenCL keeps the buffer until the march has read it).
       std::optional<cl::Buffer> map;
       std::optional<ShadowMapBuffer> shadow;
       if (const ShadowMap* s = stage.shadow()) {
@@ -261,7 +277,8 @@ class PyVolumePass : public PassObject<VolumePass> {
         });
         shadow = ShadowMapBuffer{(*map)(), s->depth.width(), s->depth.height(), s->params};
       }
-      return pass.enqueue(q(), fb, setup.camera, scene, stage.settings(), shadow ? &*shadow : nullptr, waits);
+      return pass.enqueue(c.queue(), c.buffers, c.setup.camera, scene, stage.settings(), shadow ? &*shadow : nullptr,
+                          c.waits);
     }));
   }
 
