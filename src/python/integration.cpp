@@ -129,18 +129,28 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
     if (kwargs.contains(key))
       throw py::value_error(who + ": " + key + "= is fogcl.apply's (it opens or measures a device); a pass runs on "
                             "its context's device with the options' precision and volume settings");
-  const cli::ApplyOptions o = apply_options(kwargs);
-  cli::check_apply_options(o);
-  // No file behind the frame: the camera is the options' alone (--fov, --ortho-size or the lens).
-  const cli::FrameCamera camera = cli::memory_frame_camera(o, width, height, nullptr, "the frame");
-  FrameSetup s;
-  s.camera = camera.params;
-  s.settings = o.settings;
-  if (with_volumes) {
-    s.volumes = cli::VolumeStage::create(o.volumes, nullptr);
-    if (s.volumes) s.volumes->set_frame_pose(camera.pose, camera.pose_from);
+  try {
+    const cli::ApplyOptions o = apply_options(kwargs);
+    cli::check_apply_options(o);
+    // No file behind the frame: the camera is the options' alone (--fov, --ortho-size or the lens).
+    const cli::FrameCamera camera = cli::memory_frame_camera(o, width, height, nullptr, "the frame");
+    FrameSetup s;
+    s.camera = camera.params;
+    s.settings = o.settings;
+    if (with_volumes) {
+      s.volumes = cli::VolumeStage::create(o.volumes, nullptr);
+      if (s.volumes) s.volumes->set_frame_pose(camera.pose, camera.pose_from);
+    }
+    return s;
+  } catch (const py::error_already_set&) {
+    throw;  // Python's own (a volumes= document json cannot write, an interrupt)
+  } catch (const OutOfMemory&) {
+    throw;
+  } catch (const ClError&) {
+    throw;
+  } catch (const std::exception& e) {  // the options' rules (fogcl::Error, or python/options.h's ValueError)
+    throw py::value_error(who + ": " + e.what());
   }
-  return s;
 }
 
 // An enqueue's arguments, checked before the pass runs.
