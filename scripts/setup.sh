@@ -7,6 +7,7 @@ packages=(
   libglm-dev libimath-dev libopenexr-dev libpng-dev libcli11-dev nlohmann-json3-dev pkg-config
   libgtest-dev libbenchmark-dev
   python3-matplotlib
+  pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-pyopencl
 )
 # PyOpenCL, for the Python module's passes on a PyOpenCL context (tests/python/test_integration.py).
 packages+=(python3-pyopencl)

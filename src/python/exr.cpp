@@ -18,12 +18,29 @@ namespace fogcl::python {
 
 namespace {
 
+struct OsError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
 // What fogcl.read_exr returns: the pixels as arrays, the camera, and the file's description that
 // fogcl.write_exr(source=...) writes the fogged frame into (its other parts, channels, attributes).
 struct ExrFrame {
   py::array color, depth;
   ExrInput header;  // without pixels
 };
+
+// A file that cannot be read or written (missing, not an EXR, corrupt, a folder that is not there)
+// is Python's OSError, as for open(); with the library's message, which names the file.
+template <class F>
+void file_call(F&& f) {
+  try {
+    f();
+  } catch (const OutOfMemory&) {
+    throw;
+  } catch (const Error& e) {
+    throw OsError(e.what());
+  }
+}
 
 py::tuple vec3(const glm::vec3& v) { return py::make_tuple(v.x, v.y, v.z); }
 py::tuple window(const glm::ivec2& lo, const glm::ivec2& hi) { return py::make_tuple(lo.x, lo.y, hi.x, hi.y); }
@@ -46,7 +63,7 @@ ExrFrame read(const std::string& path, const std::string& depth_path, const std:
   DepthImage depth;
   {
     py::gil_scoped_release release;
-    cli::read_frame_files(o, path, depth_path, f.header, depth);
+    file_call([&] { cli::read_frame_files(o, path, depth_path, f.header, depth); });
   }
   f.color = color_array(std::move(f.header.color));
   f.depth = depth_array(std::move(depth));
@@ -76,7 +93,7 @@ void write(const std::string& path, const py::array& color, const py::object& so
   }
   const ColorImage image = color_image_of(color, "color");
   py::gil_scoped_release release;
-  write_exr_output(path, image, header, rgba_only, w);
+  file_call([&] { write_exr_output(path, image, header, rgba_only, w); });
 }
 
 void write_depth(const std::string& path, const py::array& depth) {
@@ -85,12 +102,19 @@ void write_depth(const std::string& path, const py::array& depth) {
   DepthImage image(v.width(), v.height());
   for (int y = 0; y < v.height(); ++y) std::copy_n(v.row(y), v.width(), image.view().row(y));
   py::gil_scoped_release release;
-  write_exr_depth(path, image);
+  file_call([&] { write_exr_depth(path, image); });
 }
 
 }  // namespace
 
 void bind_exr(py::module_& m) {
+  py::register_local_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const OsError& e) {
+      PyErr_SetString(PyExc_OSError, e.what());
+    }
+  });
   py::class_<ExrCamera>(m, "Camera", "The camera of an EXR's worldToNDC and worldToCamera attributes (fogcl.read_exr).")
       .def_readonly("present", &ExrCamera::present, "Both matrices there and a symmetric perspective")
       .def_readonly("fov_y_deg", &ExrCamera::fov_y_deg, "Vertical field of view [degrees]")

@@ -130,7 +130,13 @@ py::array apply(const py::array& color, const py::array& depth, const py::object
       ~InFlight() { --g_in_flight; }
     } in_flight;
     fogger = pool().take(key);
-    if (!fogger) fogger = std::make_unique<cli::MemoryFogger>(o);
+    if (!fogger) {
+      // One opening at a time: the OpenCL ICD loader's and PoCL's first platform query are not
+      // safe from several threads at once (the others find no device).
+      static std::mutex opening;
+      std::lock_guard<std::mutex> lock(opening);
+      fogger = std::make_unique<cli::MemoryFogger>(o);
+    }
     before = pass_stats(fogger->backend());
     fogger->fog(frame);
   }

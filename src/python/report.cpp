@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include "cli/cli.h"
+#include "cli/flag_values.h"
 #include "fogcl/report.h"
 #include "python/bindings.h"
 
@@ -21,6 +22,7 @@ py::tuple report_rows(int width, int height, int runs, const std::string& device
       throw Error(std::string(flag) + " must be in [1, 16384] (got " + std::to_string(value) + ")");
   if (runs < 7 || runs > 1000)
     throw Error("--runs must be >= 7 for the deferred report (got " + std::to_string(runs) + ")");
+  if (!device.empty()) cli::check_device("--device", device);
   Report report;
   {
     py::gil_scoped_release release;

@@ -115,3 +115,29 @@ def test_threads_give_the_bits_of_one_thread():
     print("worst |threaded - serial| =", max(worst(a, b) for a, b in zip(results, expected)))
     for a, b in zip(results, expected):
         assert np.array_equal(bits(a), bits(b))
+
+
+def test_threads_that_open_the_device_at_once():
+    """A fresh process whose first calls come from several threads at once: each opens the device
+    (one at a time) and gets the serial bits."""
+    import subprocess
+    import sys
+    script = """
+import threading, numpy as np, fogcl
+rng = np.random.default_rng(14)
+frames = [(rng.uniform(0, 4, (16, 24, 4)).astype(np.float32), rng.uniform(0, 1, (16, 24)).astype(np.float32))
+          for _ in range(4)]
+options = dict(near=0.3, far=1000, fov=60, mode="exp2", density=0.025)
+out = [None] * 4
+def fog(i):
+    out[i] = fogcl.apply(*frames[i], **options)
+threads = [threading.Thread(target=fog, args=(i,)) for i in range(4)]
+[t.start() for t in threads]
+[t.join() for t in threads]
+serial = [fogcl.apply(*f, **options) for f in frames]
+print(max(float(np.abs(a - b).max()) for a, b in zip(out, serial)))
+assert all(np.array_equal(a.view(np.uint32), b.view(np.uint32)) for a, b in zip(out, serial))
+"""
+    r = subprocess.run([sys.executable, "-X", "faulthandler", "-c", script], capture_output=True, text=True)
+    print("worst |first threads - serial| =", r.stdout.strip(), r.stderr[-2000:])
+    assert r.returncode == 0
