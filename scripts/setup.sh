@@ -9,8 +9,6 @@ packages=(
   python3-matplotlib
   pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-pyopencl
 )
-# PyOpenCL, for the Python module's passes on a PyOpenCL context (tests/python/test_integration.py).
-packages+=(python3-pyopencl)
 # --sanitizers: also clang and its runtimes (libFuzzer, ASan, UBSan) for `make asan-test` / `make fuzz`.
 if [ "${1:-}" = "--sanitizers" ]; then
   packages+=(clang-14 libclang-rt-14-dev)
