@@ -129,11 +129,23 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
     if (kwargs.contains(key))
       throw py::value_error(who + ": " + key + "= is fogcl.apply's (it opens or measures a device); a pass runs on "
                             "its context's device with the options' precision and volume settings");
+  // camera=: a file's camera (fogcl.read_exr(...).camera), as fogcl.apply takes it; the rest are flags.
+  py::dict flags(kwargs);
+  std::optional<ExrCamera> file_camera;
+  if (flags.contains("camera")) {
+    const py::object given = flags.attr("pop")("camera");
+    if (!given.is_none()) {
+      if (!py::isinstance<ExrCamera>(given))
+        throw py::type_error(who + ": camera must be a fogcl.Camera (fogcl.read_exr(...).camera) or None");
+      file_camera = given.cast<ExrCamera>();
+    }
+  }
   try {
-    const cli::ApplyOptions o = apply_options(kwargs);
+    const cli::ApplyOptions o = apply_options(flags);
     cli::check_apply_options(o);
-    // No file behind the frame: the camera is the options' alone (--fov, --ortho-size or the lens).
-    const cli::FrameCamera camera = cli::memory_frame_camera(o, width, height, nullptr, "the frame");
+    // The frame has no file behind it: its camera is the options' and camera='s.
+    const cli::FrameCamera camera =
+        cli::memory_frame_camera(o, width, height, file_camera ? &*file_camera : nullptr, who);
     FrameSetup s;
     s.camera = camera.params;
     s.settings = o.settings;
@@ -149,7 +161,8 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
   } catch (const ClError&) {
     throw;
   } catch (const std::exception& e) {  // the options' rules (fogcl::Error, or python/options.h's ValueError)
-    throw py::value_error(who + ": " + e.what());
+    const std::string what = e.what();
+    throw py::value_error(what.rfind(who, 0) == 0 ? what : who + ": " + what);  // named once
   }
 }
 

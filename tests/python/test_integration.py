@@ -339,6 +339,32 @@ def test_with_block_releases_and_a_released_pass_says_so(ctx, queue):
         fog.enqueue(None, None, width=8, height=8)
 
 
+def test_file_camera_as_fogcl_apply_takes_it(ctx, queue, tmp_path):
+    """camera= (fogcl.read_exr(...).camera) is taken as fogcl.apply takes it: a file without
+    worldToNDC gives no fov (the same message), and with fov= the same bits."""
+    rng = np.random.default_rng(7000)
+    width, height = 30, 20
+    color, depth = frame(rng, width, height)
+    fogcl.write_exr(str(tmp_path / "color.exr"), color)
+    fogcl.write_exr_depth(str(tmp_path / "depth.exr"), depth)
+    read = fogcl.read_exr(str(tmp_path / "color.exr"), depth=str(tmp_path / "depth.exr"))
+    options = dict(camera=read.camera, near=0.3, far=100.0, mode="exp", density=0.2)
+    fog = fogcl.FogPass(ctx, queue=queue)
+    with pytest.raises(ValueError) as ours:
+        fog.prepare(width, height, **options)
+    with pytest.raises(ValueError) as theirs:
+        fogcl.apply(read.color, read.depth, **options)
+    print(f"FogPass: {ours.value}\nfogcl.apply: {theirs.value}")
+    assert str(ours.value) == str(theirs.value).replace("fogcl.apply", "fogcl.FogPass.prepare", 1)
+
+    options["fov"] = 50.0
+    fog.prepare(width, height, **options)
+    c, d, o = to_device(ctx, read.color), to_device(ctx, read.depth), to_device(ctx, np.zeros_like(read.color))
+    event = fog.enqueue(c, d, o, width=width, height=height, **options)
+    got = from_device(queue, o, read.color, wait_for=[event])
+    assert report_bits("camera= and fov=", got, fogcl.apply(read.color, read.depth, **options)) == 0
+
+
 def bad_call(ctx, q, **change):
     """FogPass.enqueue of an 8x4 float frame with one argument changed."""
     width, height = 8, 4
@@ -391,13 +417,15 @@ def test_pass_setup_errors(ctx, queue):
     with pytest.raises(ValueError, match="--nearr|nearr"):
         fog.prepare(2, 2, nearr=0.3)
     camera = dict(near=0.3, far=100.0, mode="exp", density=0.1)
-    with pytest.raises(ValueError, match=r"prepare: the frame: no --fov or --focal-length given \(nor --ortho-size\)"):
+    with pytest.raises(ValueError, match=r"^fogcl.FogPass.prepare: no --fov or --focal-length given \(nor --ortho-size\)"):
         fog.prepare(2, 2, **camera)
     with pytest.raises(ValueError, match=r"prepare: give either --fov .* or --ortho-size .*, not both"):
         fog.prepare(2, 2, fov=60.0, ortho_size=3.0, **camera)
     for key, value in [("device", "cpu"), ("max_error", 1e-3), ("host_transfer", "staged"), ("max_memory", "1G")]:
         with pytest.raises(ValueError, match=f"enqueue: {key}= is fogcl.apply's"):
             fog.enqueue(c, d, width=2, height=2, queue=queue, fov=60.0, **camera, **{key: value})
+    with pytest.raises(TypeError, match="camera must be a fogcl.Camera"):
+        fog.prepare(2, 2, camera="wide", fov=60.0, **camera)
     volumes = fogcl.VolumePass(ctx, queue=queue)
     with pytest.raises(ValueError, match="no volumes: give volumes="):
         volumes.prepare(2, 2, near=0.3, far=100.0, fov=60.0, mode="off")
