@@ -576,6 +576,8 @@ int sweep_stale_temporaries(const FramePattern& pattern) {
 
 }  // namespace
 
+namespace {
+
 // The rules the options make together, before any file is touched (also for a frame in memory).
 void check_apply_options(const ApplyOptions& o) {
   parse_depth_kind(o.depth_kind);
@@ -593,6 +595,8 @@ void check_apply_options(const ApplyOptions& o) {
     throw Error("--pixel-type must be half or float (got '" + o.pixel_type + "')");
   if (!o.compression.empty()) parse_exr_compression(o.compression);
 }
+
+}  // namespace
 
 int run_apply(const ApplyOptions& o) {
   set_memory_stage("checking the options and the files");
