@@ -570,6 +570,8 @@ int sweep_stale_temporaries(const FramePattern& pattern) {
 
 }  // namespace
 
+namespace {
+
 // The rules the options make together, before any file is touched (also for a frame in memory).
 void check_apply_options(const ApplyOptions& o) {
   parse_depth_kind(o.depth_kind);
@@ -587,6 +589,8 @@ void check_apply_options(const ApplyOptions& o) {
     throw Error("--pixel-type must be half or float (got '" + o.pixel_type + "')");
   if (!o.compression.empty()) parse_exr_compression(o.compression);
 }
+
+}  // namespace
 
 int run_apply(const ApplyOptions& o) {
   set_memory_stage("checking the options and the files");
@@ -855,6 +859,7 @@ VolumeStage* MemoryFogger::volumes() { return devices_->devices.volumes.get(); }
 
 FrameCamera memory_frame_camera(const ApplyOptions& o, int width, int height, const ExrCamera* camera,
                                 const std::string& name) {
+  check_apply_options(o);
   // What the frame code reads of a file besides its pixels: its name, size and camera.
   ExrInput header;
   header.path = name;

@@ -37,9 +37,6 @@ struct FrameReadHooks {
 void read_frame_files(const ApplyOptions& o, const std::string& color_path, const std::string& depth_path,
                       ExrInput& color, DepthImage& depth, const FrameReadHooks& hooks = {});
 
-// The rules the options make together (`fogcl apply`'s, before any file is touched).
-void check_apply_options(const ApplyOptions& o);
-
 // The camera of one frame, and the poses the volumes and height fog take from it. text,
 // pose_from, height_pose_from: what --verbose says of them.
 struct FrameCamera {
@@ -49,9 +46,10 @@ struct FrameCamera {
   std::string pose_from, height_pose_from;
 };
 // The camera of a width x height frame in memory as `fogcl apply` derives a file's: from the
-// options, and `camera` (the attributes of the file it came from; null: none). `name` names the
-// frame in messages. For callers that run the passes themselves (the Python module's FogPass and
-// VolumePass on the caller's OpenCL objects). Throws fogcl::Error naming the flags.
+// options, and `camera` (the attributes of the file it came from; null: none), after the rules the
+// options make together. `name` names the frame in messages. For callers that run the passes
+// themselves (the Python module's FogPass and VolumePass on the caller's OpenCL objects). Throws
+// fogcl::Error naming the flags.
 FrameCamera memory_frame_camera(const ApplyOptions& o, int width, int height, const ExrCamera* camera,
                                 const std::string& name);
 

@@ -142,7 +142,6 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
   }
   try {
     const cli::ApplyOptions o = apply_options(flags);
-    cli::check_apply_options(o);
     // The frame has no file behind it: its camera is the options' and camera='s.
     const cli::FrameCamera camera =
         cli::memory_frame_camera(o, width, height, file_camera ? &*file_camera : nullptr, who);

@@ -1,6 +1,9 @@
 #include "python/options.h"
 
+#include <cstdlib>
+
 #include "cli/apply_flags.h"
+#include "cli/flag_values.h"
 #include "cli/usage.h"
 
 namespace py = pybind11;
@@ -68,6 +71,10 @@ cli::ApplyOptions apply_options(const py::dict& options) {
   std::string volumes_text;
   const std::vector<std::string> args = option_args(options, &volumes_text);
   try {
+    // FOGCL_DEVICE is device='s default, under the same rule (as for the command line).
+    const char* env_device = std::getenv("FOGCL_DEVICE");
+    if (env_device != nullptr && *env_device != '\0' && !options.contains("device"))
+      cli::check_device("FOGCL_DEVICE", env_device);
     cli::ApplyOptions o = cli::parse_memory_apply_args(args);
     o.volumes.volumes_text = volumes_text;
     return o;

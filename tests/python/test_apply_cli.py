@@ -104,3 +104,25 @@ def test_file_camera_is_the_cli_bit_for_bit(cli, tmp_path):
     print("module:", e.value, "| cli:", r.stderr.strip())
     assert r.returncode == 1
     assert str(e.value).split(": ", 1)[1] == r.stderr.strip().split(": ", 3)[3]
+
+
+@pytest.mark.parametrize("axes", ["blender", "houdini"])
+def test_renderer_camera_is_the_cli_bit_for_bit(cli, tmp_path, axes):
+    """The renderer camera's flags as keywords: a camera-to-world matrix in the renderer's axes and
+    a lens instead of fov=, for height fog (which takes its pose from the matrix)."""
+    rng = np.random.default_rng([41, ["blender", "houdini"].index(axes)])
+    angle = float(rng.uniform(-1, 1))
+    c, s = np.cos(angle), np.sin(angle)
+    # A rotation about the renderer's up axis and a translation, as the renderer prints them:
+    # Blender's column vectors, Houdini's row vectors (the transpose).
+    m = (np.array([[c, -s, 0, 1.5], [s, c, 0, -2.0], [0, 0, 1, 3.0], [0, 0, 0, 1]]) if axes == "blender" else
+         np.array([[c, 0, s, 1.5], [0, 1, 0, 3.0], [-s, 0, c, -2.0], [0, 0, 0, 1]]).T)
+    options = {"near": 0.1, "far": 500.0, "mode": "height", "density": float(rng.uniform(0.02, 0.1)),
+               "camera_to_world": tuple(float(x) for x in m.ravel()), "axes": axes,
+               "focal_length": float(rng.uniform(20, 80)), "sensor_width": 36.0, "distance": True}
+    color, depth = random_frame(rng, 23, 41)
+    rc, err, expected = run_cli(cli, tmp_path, color, depth, options)
+    assert rc == 0, err
+    got = fogcl.apply(color, depth, **options)
+    print(f"{axes} camera, lens {options['focal_length']:.1f} mm: worst |module - cli| = {worst(got, expected)}")
+    assert np.array_equal(bits(got), bits(expected))
