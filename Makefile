@@ -31,7 +31,9 @@ gpu-bundle:
 	scripts/gpu-bundle.sh $(BUILD) out/gpu-bundle
 
 # Sanitizer build (clang): the whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer,
-# and the libFuzzer targets over EXR loading and VOLUMES.json, from one build folder.
+# and the libFuzzer targets over EXR loading and VOLUMES.json, from one build folder. Without the
+# Python module: a sanitized extension cannot load into the unsanitized interpreter (`make test`
+# runs its tests).
 # detect_leaks=0: PoCL and the OpenCL ICD loader keep process-lifetime allocations (LLVM's JIT
 # state, the platform list) that LeakSanitizer reports at exit; fogcl's own leaks would show in the
 # scalar/IO tests (docs/cli.md, "Errors"). allocator_may_return_null=1: an allocation too large for
@@ -47,7 +49,7 @@ asan-build:
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_COMPILER=clang++-14 \
 	  -DCMAKE_CXX_FLAGS_DEBUG="-O2 -g" -DCMAKE_CXX_FLAGS="$(SANITIZE) -fsanitize=fuzzer-no-link" \
 	  -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE)" \
-	  -DFOGCL_BUILD_BENCH=OFF -DFOGCL_BUILD_FUZZ=ON
+	  -DFOGCL_BUILD_BENCH=OFF -DFOGCL_BUILD_FUZZ=ON -DFOGCL_PYTHON=OFF
 	cmake --build $(ASAN_BUILD) -j $(JOBS)
 
 # Every test but the 1080p / 8K frame sizes, which under ASan run the same host code as the smaller

@@ -8,6 +8,7 @@ packages=(
   libgtest-dev libbenchmark-dev
   libvulkan-dev  # examples/vulkan_exporter.cpp and the Vulkan rows of the interop bench
   python3-matplotlib
+  pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-pyopencl
 )
 # --sanitizers: also clang and its runtimes (libFuzzer, ASan, UBSan) for `make asan-test` / `make fuzz`.
 if [ "${1:-}" = "--sanitizers" ]; then

@@ -28,6 +28,7 @@
 #include "cli/file_checks.h"
 #include "cli/frame_memory.h"
 #include "cli/frame_pipeline.h"
+#include "cli/memory_frame.h"
 #include "cli/sequence.h"
 #include "cli/volumes_cli.h"
 #include "fogcl/depth_kinds.h"
@@ -36,6 +37,50 @@
 #include "io/atomic_file.h"
 
 namespace fogcl::cli {
+
+namespace {
+// Outside the depth's data window (and in empty deep pixels) there is nothing: background. Raw
+// depth gets the sky value; eye / distance depth gets +inf, which converts to it.
+float depth_outside(const ApplyOptions& o) {
+  return parse_depth_kind(o.depth_kind) == DepthKind::raw ? (o.reversed_z ? 0.0f : 1.0f)
+                                                          : std::numeric_limits<float>::infinity();
+}
+}  // namespace
+
+void read_frame_files(const ApplyOptions& o, const std::string& color_path, const std::string& depth_path,
+                      ExrInput& color, DepthImage& depth, const FrameReadHooks& hooks) {
+  const float outside = depth_outside(o);
+  ExrReadRequest request;
+  request.layer = o.layer;
+  request.depth_outside = outside;
+  // Half output of half input: fog in half storage, so that f == 1 pixels keep their bits (§2).
+  request.keep_half = o.pixel_type == "half";
+  if (depth_path.empty()) request.depth_channel = o.depth_channel;
+  request.color_into = hooks.color_into;
+  request.depth_into = hooks.depth_into;
+  request.before_allocating = hooks.before_allocating;
+  color = read_exr(color_path, request);
+  if (hooks.color_read) hooks.color_read(color);
+
+  if (depth_path.empty()) {
+    depth = std::move(color.depth);
+  } else {
+    ExrReadRequest depth_request;
+    depth_request.read_color = false;
+    depth_request.depth_channel = o.depth_channel;
+    depth_request.depth_single_channel_fallback = true;
+    depth_request.depth_outside = outside;
+    depth_request.depth_into = hooks.depth_into;
+    // Before its frame is allocated: a depth file describing another (larger) frame costs nothing.
+    depth_request.before_allocating = [&](const ExrFrameShape& shape) {
+      if (!(shape.windows == color.windows))
+        throw Error(depth_path + ": data/display window differs from " + color_path +
+                    "'s: depth and color must cover the same pixels");
+    };
+    ExrInput d = read_exr(depth_path, depth_request);
+    depth = std::move(d.depth);
+  }
+}
 
 namespace {
 
@@ -69,6 +114,13 @@ void check_sequence_outputs(const ApplyOptions& o, const FramePattern& color, co
   check_sequence_files(inputs, outputs);
 }
 
+// Width / height of the frame: its display window (also for a frame in memory, whose pixels
+// ExrInput does not hold).
+float display_aspect(const ExrInput& color) {
+  const glm::ivec2 size = color.windows.display_max - color.windows.display_min + 1;
+  return float(size.x) / float(size.y);
+}
+
 // The camera of one frame: flags win over the color file's worldToNDC / worldToCamera.
 PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std::string* from) {
   PerspectiveCamera camera;
@@ -77,7 +129,7 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
   camera.reversed_z = o.reversed_z;
   camera.infinite_far = o.infinite_far;
   if (o.camera.lens) {  // lens data: the fov for this frame's aspect (cli/camera_cli.h)
-    camera.aspect = o.aspect != 0.0f ? o.aspect : float(color.color.width()) / float(color.color.height());
+    camera.aspect = o.aspect != 0.0f ? o.aspect : display_aspect(color);
     camera.fov_y_deg = lens_fov_deg(o.camera, camera.aspect);
     *from = std::string("--focal-length, --sensor-fit ") + to_string(o.camera.lens->fit);
     return camera;
@@ -99,7 +151,7 @@ PerspectiveCamera frame_camera(const ApplyOptions& o, const ExrInput& color, std
   else if (o.fov == 0.0f && color.camera.present)
     camera.aspect = color.camera.aspect;
   else
-    camera.aspect = float(color.color.width()) / float(color.color.height());
+    camera.aspect = display_aspect(color);
   return camera;
 }
 
@@ -127,7 +179,7 @@ CameraParams frame_params_of(const ApplyOptions& o, const ExrInput& color, std::
   if (o.ortho_size > 0.0f) {
     OrthographicCamera camera;
     camera.ortho_size = o.ortho_size;
-    camera.aspect = o.aspect != 0.0f ? o.aspect : float(color.color.width()) / float(color.color.height());
+    camera.aspect = o.aspect != 0.0f ? o.aspect : display_aspect(color);
     camera.near_plane = o.near_plane;
     camera.far_plane = o.far_plane;
     camera.reversed_z = o.reversed_z;
@@ -186,6 +238,23 @@ FogSettings pass_settings(const ApplyOptions& o, Backend& backend, ColorFormat s
   return s;
 }
 
+// The camera of one frame (cli/memory_frame.h's FrameCamera) from the options and the color file's
+// header.
+FrameCamera frame_camera_setup(const ApplyOptions& o, const ExrInput& color) {
+  const DepthKind kind = parse_depth_kind(o.depth_kind);
+  FrameCamera c;
+  c.params = frame_params(o, color, &c.text);
+  c.pose = frame_pose(o.camera, o.volumes, color, &c.pose_from);
+  c.params.pose = height_frame_pose(o, color, &c.height_pose_from);  // --mode height: the pose per frame
+  validate(o.settings);
+  if (kind == DepthKind::distance && c.params.projection == Projection::orthographic)
+    throw Error("--depth-kind distance needs a perspective camera (an orthographic camera's rays are parallel: "
+                "give eye or raw depth with --ortho-size)");
+  // Linear depth reaches the kernels as it is (a variant of its own), never through raw depth.
+  c.params.depth_kind = kind;
+  return c;
+}
+
 // One frame in flight through read -> fog -> write (frame_pipeline.h).
 struct FrameJob {
   int frame = 0;       // the frame number (0 for a single file)
@@ -215,55 +284,23 @@ struct InputFrames {
 // the run's. spare: frames to read into when they fit (may be null).
 void read_frame(const ApplyOptions& o, const MemoryLimit& limit, FrameJob& job, InputFrames* spare = nullptr) {
   const FramePaths& paths = job.paths;
-  const DepthKind kind = parse_depth_kind(o.depth_kind);
-  // Outside the depth's data window (and in empty deep pixels) there is nothing: background.
-  // Raw depth gets the sky value; eye / distance depth gets +inf, which converts to it.
-  const float outside = kind == DepthKind::raw ? (o.reversed_z ? 0.0f : 1.0f) : std::numeric_limits<float>::infinity();
-
-  ExrReadRequest request;
-  request.layer = o.layer;
-  request.depth_outside = outside;
-  // Half output of half input: fog in half storage, so that f == 1 pixels keep their bits (§2).
-  request.keep_half = o.pixel_type == "half";
-  if (paths.depth.empty()) request.depth_channel = o.depth_channel;
+  FrameReadHooks hooks;
   if (spare != nullptr) {
-    request.color_into = &spare->color;
-    request.depth_into = &spare->depth;
+    hooks.color_into = &spare->color;
+    hooks.depth_into = &spare->depth;
   }
   // What the frame will need is checked from its header, before anything is allocated.
   const FrameMemoryNeeds needs = frame_memory_needs(o);
-  request.before_allocating = [&](const ExrFrameShape& shape) { check_frame_memory(paths.color, shape, needs, limit); };
-  job.color = read_exr(paths.color, request);
-  const ExrInput& color = job.color;
-
-  job.params = frame_params(o, color, &job.camera_text);
-  job.pose = frame_pose(o.camera, o.volumes, color, &job.pose_from);
-  job.params.pose = height_frame_pose(o, color, &job.height_pose_from);  // --mode height: the pose per frame
-  validate(o.settings);
-  if (kind == DepthKind::distance && job.params.projection == Projection::orthographic)
-    throw Error("--depth-kind distance needs a perspective camera (an orthographic camera's rays are parallel: "
-                "give eye or raw depth with --ortho-size)");
-  // Linear depth reaches the kernels as it is (a variant of its own), never through raw depth.
-  job.params.depth_kind = kind;
-
-  if (paths.depth.empty()) {
-    job.depth = std::move(job.color.depth);
-  } else {
-    ExrReadRequest depth_request;
-    depth_request.read_color = false;
-    depth_request.depth_channel = o.depth_channel;
-    depth_request.depth_single_channel_fallback = true;
-    depth_request.depth_outside = outside;
-    if (spare != nullptr) depth_request.depth_into = &spare->depth;
-    // Before its frame is allocated: a depth file describing another (larger) frame costs nothing.
-    depth_request.before_allocating = [&](const ExrFrameShape& shape) {
-      if (!(shape.windows == color.windows))
-        throw Error(paths.depth + ": data/display window differs from " + paths.color +
-                    "'s: depth and color must cover the same pixels");
-    };
-    ExrInput d = read_exr(paths.depth, depth_request);
-    job.depth = std::move(d.depth);
-  }
+  hooks.before_allocating = [&](const ExrFrameShape& shape) { check_frame_memory(paths.color, shape, needs, limit); };
+  hooks.color_read = [&](const ExrInput& color) {
+    FrameCamera camera = frame_camera_setup(o, color);
+    job.params = camera.params;
+    job.camera_text = std::move(camera.text);
+    job.pose = camera.pose;
+    job.pose_from = std::move(camera.pose_from);
+    job.height_pose_from = std::move(camera.height_pose_from);
+  };
+  read_frame_files(o, paths.color, paths.depth, job.color, job.depth, hooks);
 }
 
 // Frames that are done with (written outputs, fogged inputs), kept for the next frames: a fresh
@@ -371,6 +408,24 @@ std::string open_devices(const ApplyOptions& o, std::promise<std::shared_ptr<Dev
   }
 }
 
+// The volume pass of a frame, which reads eye depth: distance depth is converted first
+// (to_eye_depth: no digit lost).
+template <class In, class Depth, class Out>
+void apply_volumes(VolumeStage& volumes, const In& in, const Depth& depth, Out& out, const CameraParams& params,
+                   int sequence_frame, bool verbose) {
+  if (params.depth_kind != DepthKind::distance) {
+    volumes.apply(in, depth, out, params, sequence_frame, verbose);
+    return;
+  }
+  DepthImage eye(depth.width(), depth.height());
+  for (int y = 0; y < depth.height(); ++y)
+    std::copy_n(ConstDepthView(depth).row(y), depth.width(), eye.view().row(y));
+  to_eye_depth(eye, params.depth_kind, params);
+  CameraParams eye_params = params;
+  eye_params.depth_kind = DepthKind::eye;
+  volumes.apply(in, eye, out, eye_params, sequence_frame, verbose);
+}
+
 void print_build_options(Backend& backend, const Variant& variant) {
   if (!backend.is_scalar() && variant.needs_pass())
     std::fprintf(stderr, "build options: %s\n", backend.pass()->build_options_for(variant).c_str());
@@ -428,15 +483,8 @@ void fog_frame(const ApplyOptions& o, Backend& backend, FrameJob& job, bool prin
   if (volumes != nullptr) volumes->set_frame_pose(job.pose, job.pose_from);
   // docs/DESIGN.md §5: the volumes first, the deferred fog on their result. In place: the input's
   // pixels are not needed again, and a sequence allocates no extra frame.
-  if (volumes != nullptr && params.depth_kind == DepthKind::distance) {
-    DepthImage eye = job.depth;  // the volume pass reads eye depth (to_eye_depth: no digit lost)
-    to_eye_depth(eye, params.depth_kind, params);
-    CameraParams eye_params = params;
-    eye_params.depth_kind = DepthKind::eye;
-    volumes->apply(job.color.color, eye, job.color.color, eye_params, sequence_frame, print_setup);
-  } else if (volumes != nullptr) {
-    volumes->apply(job.color.color, job.depth, job.color.color, params, sequence_frame, print_setup);
-  }
+  if (volumes != nullptr)
+    apply_volumes(*volumes, job.color.color, job.depth, job.color.color, params, sequence_frame, print_setup);
   job.pending = backend.apply_async(color.color, job.depth, job.out, params, settings);
 }
 
@@ -522,10 +570,12 @@ int sweep_stale_temporaries(const FramePattern& pattern) {
 
 }  // namespace
 
-int run_apply(const ApplyOptions& o) {
-  set_memory_stage("checking the options and the files");
-  parse_depth_kind(o.depth_kind);  // a bad kind fails before any file is touched
-  const MemoryLimit memory = memory_limit(o.max_memory);  // so does a bad --max-memory
+namespace {
+
+// The rules the options make together, before any file is touched (also for a frame in memory).
+void check_apply_options(const ApplyOptions& o) {
+  parse_depth_kind(o.depth_kind);
+  memory_limit(o.max_memory);
   if (o.fov != 0.0f && o.ortho_size != 0.0f)
     throw Error("give either --fov (perspective) or --ortho-size (orthographic), not both");
   if (o.ortho_size != 0.0f && o.infinite_far)
@@ -538,6 +588,14 @@ int run_apply(const ApplyOptions& o) {
   if (o.pixel_type != "float" && o.pixel_type != "half")
     throw Error("--pixel-type must be half or float (got '" + o.pixel_type + "')");
   if (!o.compression.empty()) parse_exr_compression(o.compression);
+}
+
+}  // namespace
+
+int run_apply(const ApplyOptions& o) {
+  set_memory_stage("checking the options and the files");
+  check_apply_options(o);
+  const MemoryLimit memory = memory_limit(o.max_memory);
   const FramePattern color = parse_frame_pattern(o.color_path);
   const FramePattern depth = parse_frame_pattern(o.depth_path);
   const FramePattern out = parse_frame_pattern(o.out_path);
@@ -782,6 +840,54 @@ int run_apply(const ApplyOptions& o) {
                  outcome.total_s > 0 ? double(outcome.finished) / outcome.total_s : 0.0);
   }
   return 0;
+}
+
+// ---- A frame in memory (cli/memory_frame.h) ------------------------------------------------------
+
+struct MemoryFogger::Opened {
+  Devices devices;
+  explicit Opened(const ApplyOptions& o) : devices(o) {}
+};
+
+MemoryFogger::MemoryFogger(const ApplyOptions& options) : options_(options) {
+  check_apply_options(options_);
+  devices_ = std::make_unique<Opened>(options_);
+}
+MemoryFogger::~MemoryFogger() = default;
+Backend& MemoryFogger::backend() { return devices_->devices.backend; }
+VolumeStage* MemoryFogger::volumes() { return devices_->devices.volumes.get(); }
+
+FrameCamera memory_frame_camera(const ApplyOptions& o, int width, int height, const ExrCamera* camera,
+                                const std::string& name) {
+  check_apply_options(o);
+  // What the frame code reads of a file besides its pixels: its name, size and camera.
+  ExrInput header;
+  header.path = name;
+  header.windows.display_max = header.windows.data_max = glm::ivec2(width - 1, height - 1);
+  if (camera != nullptr) header.camera = *camera;
+  return frame_camera_setup(o, header);
+}
+
+void MemoryFogger::fog(const MemoryFrame& f) {
+  const ApplyOptions& o = options_;
+  validate_frame(f.color, f.depth, f.out);
+  const FrameCamera camera = memory_frame_camera(o, f.color.width(), f.color.height(), f.camera, f.name);
+  const CameraParams& params = camera.params;
+  Backend& backend = devices_->devices.backend;
+  if (backend.runtime() != nullptr)
+    check_device_allocations(f.name, *backend.runtime(), f.color.width(), f.color.height(), f.color.format(),
+                             frame_memory_needs(o));
+  std::string precision_why;
+  const FogSettings settings = pass_settings(o, backend, f.color.format(), &precision_why);
+  VolumeStage* volumes = devices_->devices.volumes.get();
+  if (volumes == nullptr) {
+    backend.apply(f.color, f.depth, f.out, params, settings);
+    return;
+  }
+  // As fog_frame: the volumes first, the deferred fog on their result (here in `out`).
+  volumes->set_frame_pose(camera.pose, camera.pose_from);
+  apply_volumes(*volumes, f.color, f.depth, f.out, params, -1, false);
+  backend.apply(f.out, f.depth, f.out, params, settings);
 }
 
 }  // namespace fogcl::cli

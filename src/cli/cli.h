@@ -27,6 +27,9 @@ class Backend {
   // scalar path (a finished frame).
   PendingFrame apply_async(const ColorImage& in, const DepthImage& depth, ColorImage& out,
                            const CameraParams& camera, const FogSettings& settings);
+  // apply() over the caller's memory (a frame in memory: the Python module); out may be in.
+  void apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+             const CameraParams& camera, const FogSettings& settings);
   FogPass* pass() { return pass_.get(); }
   const Runtime* runtime() const { return runtime_.get(); }  // null for scalar
 

@@ -74,6 +74,30 @@ std::string pocl_cache_problem() {
          "; set POCL_CACHE_DIR to a writable folder, or use --device scalar";
 }
 
+// The scalar path in row bands on OpenEXR's pool of `threads`.
+void apply_in_bands(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                    const CameraParams& camera, const FogSettings& settings, int threads) {
+  // A few bands per thread so that uneven bands (sky rows are cheap) still keep every worker busy;
+  // each pixel gets the bits that one apply_fog_scalar call would give it.
+  const int bands = std::min(in.height(), 4 * threads);
+  std::vector<std::string> errors(static_cast<std::size_t>(bands));
+  {
+    IlmThread::TaskGroup group;  // its destructor waits for every band
+    for (int b = 0; b < bands; ++b) {
+      const int first = int(std::int64_t(in.height()) * b / bands), end = int(std::int64_t(in.height()) * (b + 1) / bands);
+      IlmThread::ThreadPool::addGlobalTask(new RowsTask(&group, [&, b, first, end] {
+        try {
+          apply_fog_scalar_rows(in, depth, out, camera, settings, first, end);
+        } catch (const std::exception& e) {
+          errors[std::size_t(b)] = e.what();
+        }
+      }));
+    }
+  }
+  for (const std::string& e : errors)
+    if (!e.empty()) throw Error(e);
+}
+
 }  // namespace
 
 std::string device_choice_source(const std::string& choice) {
@@ -125,25 +149,21 @@ void Backend::apply(const ColorImage& in, const DepthImage& depth, ColorImage& o
   }
   if (out.width() != in.width() || out.height() != in.height() || out.format() != in.format())
     out = ColorImage(in.width(), in.height(), in.format());
-  // A few bands per thread so that uneven bands (sky rows are cheap) still keep every worker busy;
-  // each pixel gets the bits that one apply_fog_scalar call would give it.
-  const int bands = std::min(in.height(), 4 * threads);
-  std::vector<std::string> errors(static_cast<std::size_t>(bands));
-  {
-    IlmThread::TaskGroup group;  // its destructor waits for every band
-    for (int b = 0; b < bands; ++b) {
-      const int first = int(std::int64_t(in.height()) * b / bands), end = int(std::int64_t(in.height()) * (b + 1) / bands);
-      IlmThread::ThreadPool::addGlobalTask(new RowsTask(&group, [&, b, first, end] {
-        try {
-          apply_fog_scalar_rows(in, depth, out, camera, settings, first, end);
-        } catch (const std::exception& e) {
-          errors[std::size_t(b)] = e.what();
-        }
-      }));
-    }
+  apply_in_bands(in, depth, out, camera, settings, threads);
+}
+
+void Backend::apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                    const CameraParams& camera, const FogSettings& settings) {
+  if (pass_) {
+    pass_->apply(in, depth, out, camera, settings);
+    return;
   }
-  for (const std::string& e : errors)
-    if (!e.empty()) throw Error(e);
+  const int threads = pool_threads();
+  if (threads <= 1 || in.empty() || out.data() == in.data()) {
+    apply_fog_scalar(in, depth, out, camera, settings);
+    return;
+  }
+  apply_in_bands(in, depth, out, camera, settings, threads);
 }
 
 }  // namespace fogcl::cli

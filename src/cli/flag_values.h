@@ -153,6 +153,26 @@ inline void check_device(const std::string& flag, const std::string& text) {
                   "'; keywords are lowercase: " + w + ")");
 }
 
+inline const char* const kDeviceHelp =
+    "cpu (default: PoCL's CPU device), gpu, scalar (one-thread C++ path) or part of an OpenCL "
+    "device name (any case); default from the FOGCL_DEVICE environment variable";
+
+inline CLI::Validator device_check(const std::string& flag) {
+  return value_check([flag](const std::string& text) { check_device(flag, text); });
+}
+
+// A file name that may hold a frame placeholder (cli/sequence.h): not empty, one valid placeholder.
+inline CLI::Validator path_check(const std::string& flag, const std::string& what) {
+  return value_check([flag, what](const std::string& text) {
+    require_text(flag, text, what);
+    try {
+      parse_frame_pattern(text);
+    } catch (const Error& e) {
+      throw Error(flag + " " + e.what());
+    }
+  });
+}
+
 // --frames: "FRAME" or "FIRST-LAST" in digits (else malformed); the range rules are
 // parse_frame_range's.
 inline void check_frame_range_text(const std::string& text) {

@@ -295,7 +295,10 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
       throw Error("--max-error must be a number >= 0 (got " + str(o.max_error) + ")");
   }
 
-  if (!o.volumes_path.empty()) s.volumes_ = read_volumes_json(o.volumes_path);
+  if (!o.volumes_text.empty())
+    s.volumes_ = parse_volumes_json(o.volumes_text, o.volumes_path);
+  else if (!o.volumes_path.empty())
+    s.volumes_ = read_volumes_json(o.volumes_path);
   for (FogVolume& v : s.volumes_) v = volume_to_fogcl(axes, v);
   s.runtime_ = runtime;
   if (runtime != nullptr) s.pass_ = std::make_unique<VolumePass>(*runtime);
@@ -325,6 +328,17 @@ void VolumeStage::set_frame_pose(const std::optional<CameraPose>& pose, const st
 
 void VolumeStage::apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
                         int sequence_frame, bool verbose) {
+  apply_frame(in, depth, out, camera, sequence_frame, verbose);
+}
+
+void VolumeStage::apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out,
+                        const CameraParams& camera, int sequence_frame, bool verbose) {
+  apply_frame(in, depth, out, camera, sequence_frame, verbose);
+}
+
+template <class In, class Depth, class Out>
+void VolumeStage::apply_frame(const In& in, const Depth& depth, Out& out, const CameraParams& camera,
+                              int sequence_frame, bool verbose) {
   const VolumeScene scene = scene_for(sequence_frame);
   if (options_.max_error_given && (!chosen_ || chosen_storage_ != in.format())) {
     // A missing measurement takes minutes (the 4096-step references, then every variant): say so.

@@ -26,6 +26,9 @@ namespace fogcl::cli {
 // The volume flags as given (vectors as text "X,Y,Z", parsed with messages that name the flag).
 struct VolumeCliOptions {
   std::string volumes_path;      // --volumes: "" = no volumes (no volumetric pass unless height_fog)
+  // The document itself instead of the file (the Python module's volumes= dict or list, as JSON);
+  // volumes_path then names it in messages.
+  std::string volumes_text;
   // --mode height --height-volumetric: the height fog marched in the volumetric pass (set by
   // resolve_height_flags; the deferred pass then runs no height fog).
   std::optional<FogSettings> height_fog;
@@ -96,8 +99,15 @@ class VolumeStage {
   // (and a frame of another storage) picks the variant for its storage.
   void apply(const ColorImage& in, const DepthImage& depth, ColorImage& out, const CameraParams& camera,
              int sequence_frame, bool verbose);
+  // The same over the caller's memory (a frame in memory: the Python module).
+  void apply(const ConstColorView& in, const ConstDepthView& depth, const ColorView& out, const CameraParams& camera,
+             int sequence_frame, bool verbose);
 
  private:
+  template <class In, class Depth, class Out>
+  void apply_frame(const In& in, const Depth& depth, Out& out, const CameraParams& camera, int sequence_frame,
+                   bool verbose);
+
   VolumeCliOptions options_;
   std::vector<FogVolume> volumes_;
   CameraPose pose_;
