@@ -10,6 +10,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "fogcl/depth_kinds.h"
 #include "fogcl/error.h"
 #include "light_reference.h"
 #include "volume_support.h"
@@ -400,6 +401,63 @@ TEST(VolumeLights, BadLightsAreNamed) {
   LocalLight point_with_cone = base;
   point_with_cone.outer_angle = 95.0f;  // a point light has no cone: its angles are not read
   EXPECT_NO_THROW(validate(point_with_cone, 0));
+}
+
+
+// The marched height fog (docs/DESIGN.md §6.6): homogeneous (falloff 0), black (F = 0, no sun
+// lobe) so the lights are its only light, in front of a wall at eye depth 30. To the reference it
+// is a sphere around the eye larger than the view with sigma_t = beta_ext and albedo
+// beta_in / beta_ext, isotropic; the fog starts at the eye, the pass's rays at the near plane.
+TEST(VolumeLights, HeightFogGlowsAsTheQuadratureSays) {
+  constexpr float kWall = 30.0f;
+  const glm::dvec3 beta_ext(0.08), beta_in(0.05, 0.06, 0.07);
+  const ref::Medium fog_sphere{{0.0, 0.0, 0.0}, 1e3, beta_ext.x, beta_in / beta_ext, 0.0};
+  const ref::Medium volume{{0.5, 0.0, 12.0}, 3.0, 0.4, {0.9, 0.8, 0.7}, 0.5};
+  struct HeightCase {
+    const char* name;
+    bool with_volume;
+    std::vector<LocalLight> lights;
+  };
+  const std::vector<HeightCase> height_cases = {
+      {"height fog, point light", false, {point_at({1.0f, 0.5f, 8.0f}, 20.0f, 12.0f, 0.1f)}},
+      {"height fog and a volume, spot light", true,
+       {spot_at({-1.0f, 4.0f, 10.0f}, {0.1f, -1.0f, 0.3f}, 10.0f, 35.0f, 60.0f, 20.0f)}},
+      {"height fog, light at the camera", false, {point_at({0.0f, 0.0f, 0.0f}, 5.0f, 8.0f, 0.02f)}},
+  };
+  for (const HeightCase& c : height_cases) {
+    LightFrame f = light_frame(c.with_volume ? std::vector<ref::Medium>{volume} : std::vector<ref::Medium>{}, c.lights);
+    DepthImage eye(kW, kH, kWall);
+    to_raw_depth(eye, DepthKind::eye, f.params);
+    f.depth = eye;
+    VolumeSettings s = light_settings(48);
+    FogSettings fog;
+    fog.mode = FogMode::height;
+    fog.color = glm::vec3(0.0f);
+    fog.height.extinction = glm::vec3(beta_ext);
+    fog.height.inscattering = glm::vec3(beta_in);
+    s.height_fog = fog;
+    std::vector<ref::Medium> media = f.media;
+    media.push_back(fog_sphere);
+    std::vector<glm::dvec3> want(std::size_t(kW) * kH);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        glm::dvec3 o, d;
+        pixel_ray(f.params, x, y, o, d);
+        const double t_end = double(kWall) / d.z;  // from the eye (the origin) to the wall
+        want[std::size_t(y) * kW + x] = kScene * ref::transmittance(glm::dvec3(0.0), d, t_end, media) +
+                                        ref::inscattered(glm::dvec3(0.0), d, t_end, media, f.scene.lights, 300);
+      }
+    const Paths r = run_all(f, s, want);
+    std::printf("  %-36s worst relative error: scalar<double> %.3g, scalar<float> %.3g, kernel %s (brightest %.3g)\n",
+                c.name, r.scalar_double.worst, r.scalar_float.worst,
+                r.device ? std::to_string(r.kernel.worst).c_str() : "(no device)", r.scalar_double.brightest);
+    EXPECT_TRUE(r.scalar_double.finite && r.scalar_float.finite && (!r.device || r.kernel.finite)) << c.name;
+    EXPECT_LE(r.scalar_double.worst, 1e-2) << c.name;
+    EXPECT_LE(r.scalar_float.worst, 1e-2) << c.name;
+    if (r.device) {
+      EXPECT_LE(r.kernel.worst, 1e-2) << c.name;
+    }
+  }
 }
 
 }  // namespace
