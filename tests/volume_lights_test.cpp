@@ -348,7 +348,8 @@ TEST(VolumeLights, RandomLightsOnlyAddAndCulledLightsChangeNoBit) {
   EXPECT_TRUE(cone_is_point);
 }
 
-// The stylized integrator has no per-sample light: it refuses local lights, naming the rule.
+// The stylized integrator has no per-sample light: it refuses local lights, naming the rule; so
+// does the march for more lights than it holds.
 TEST(VolumeLights, StylizedRefusesLocalLights) {
   LightFrame f = light_frame({{{0.3, 0.2, 8.0}, 4.0, 0.3, {0.9, 0.8, 0.7}, 0.0}}, {point_at({0.0f, 0.0f, 8.0f}, 1.0f, 5.0f)});
   VolumeSettings s = light_settings(16);
@@ -360,6 +361,16 @@ TEST(VolumeLights, StylizedRefusesLocalLights) {
   } catch (const Error& e) {
     std::printf("  %s\n", e.what());
     EXPECT_NE(std::string(e.what()).find("physical integrator"), std::string::npos);
+  }
+  // More lights reaching a medium than the march's private arrays hold: an error that says so.
+  f.scene.lights.assign(kMaxLocalLights + 1, point_at({0.0f, 0.0f, 8.0f}, 1.0f, 5.0f));
+  try {
+    apply_volumes_scalar(f.color, f.depth, out, f.params, f.scene, light_settings(16));
+    ADD_FAILURE() << "33 lights were accepted";
+  } catch (const Error& e) {
+    std::printf("  %s\n", e.what());
+    EXPECT_NE(std::string(e.what()).find("33 local lights reach a visible medium in this frame; at most 32"),
+              std::string::npos);
   }
 }
 
