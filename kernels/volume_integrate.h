@@ -480,7 +480,7 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
           const VOL_REAL in_before[3] = {fog_in[0], fog_in[1], fog_in[2]};
           vol_height_segment(s0, s1, s_origin, wy, d0, lit, other, depth, hp, hf, fog_ext, fog_in, fog_sun_depth,
                              fog_amb, fog_sun);
-          if (n_lights > 0) {
+          if (n_lights > 0 && seg > (VOL_REAL)0) {
             /* The fog's scattering coefficient: its in-scattering depth over the segment per unit
              * length (one channel without FOG_HF_RGB); extinctions add as for the main light. */
             const int rgb = (hf & FOG_HF_RGB) != 0;

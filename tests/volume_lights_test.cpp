@@ -391,8 +391,8 @@ TEST(VolumeLights, BadLightsAreNamed) {
   with("light 3: color must be RGB, finite and >= 0", [](LocalLight& l) { l.color.z = -1.0f; });
   with("light 3: intensity must be finite and >= 0", [](LocalLight& l) { l.intensity = INFINITY; });
   with("light 3: range must be finite and in (0, 1e15]", [](LocalLight& l) { l.range = 0.0f; });
-  with("light 3: radius must be finite and in (0, range]", [](LocalLight& l) { l.radius = 20.0f; });
-  with("light 3: radius must be finite and in (0, range]", [](LocalLight& l) { l.radius = 0.0f; });
+  with("light 3: radius must be finite and in [1e-6, range]", [](LocalLight& l) { l.radius = 20.0f; });
+  with("light 3: radius must be finite and in [1e-6, range]", [](LocalLight& l) { l.radius = 1e-7f; });
   with("light 3: intensity * max(color) * max(1, 1 / radius^2) must be <= 1e30",
        [](LocalLight& l) { l.intensity = 1e25f, l.radius = 1e-5f; });
   with("light 3: direction must be a finite non-zero vector",

@@ -55,7 +55,8 @@ struct VolumeChecker {
 constexpr float kInf = INFINITY;
 constexpr float kBig = 3.4e38f;
 constexpr float kMaxLightRange = 1e15f;  // range^2 and the window's sums stay far inside float
-constexpr double kMaxLightPeak = 1e30;   // intensity * color / radius^2: sums over lights stay finite
+constexpr double kMaxLightPeak = 1e30;
+constexpr float kMinLightRadius = 1e-6f;  // radius^2 stays a normal float: the inverse square stays finite   // intensity * color / radius^2: sums over lights stay finite
 }  // namespace
 
 void validate(const FogVolume& v, std::size_t index) {
@@ -115,7 +116,7 @@ void validate(const LocalLight& l, std::size_t index) {
   c.vec("color", l.color, 0.0f, kBig, "must be RGB, finite and >= 0");
   c.real("intensity", l.intensity, 0.0f, false, kBig, false, "must be finite and >= 0");
   c.real("range", l.range, 0.0f, true, kMaxLightRange, false, "must be finite and in (0, 1e15]");
-  c.real("radius", l.radius, 0.0f, true, l.range, false, "must be finite and in (0, range]");
+  c.real("radius", l.radius, kMinLightRadius, false, l.range, false, "must be finite and in [1e-6, range]");
   const float brightest = std::max({l.color.x, l.color.y, l.color.z});
   const double peak =
       double(l.intensity) * double(brightest) * std::max(1.0, 1.0 / (double(l.radius) * double(l.radius)));

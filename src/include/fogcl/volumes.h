@@ -79,7 +79,7 @@ struct LocalLight {
   // in float).
   float intensity = 1.0f;
   float range = 10.0f;                  // [world], finite, in (0, 1e15]: nothing beyond it
-  // Source radius [world], finite, in (0, range]: the inverse square is 1 / (d^2 + radius^2), so
+  // Source radius [world], finite, in [1e-6, range]: the inverse square is 1 / (d^2 + radius^2), so
   // a sample at the light (or a ray through it) sees a finite peak intensity / radius^2.
   float radius = 0.05f;
   // Spot only. The cone's axis, from the light outward: finite, non-zero (normalised by the pass).
