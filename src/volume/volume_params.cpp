@@ -54,6 +54,9 @@ struct VolumeChecker {
 };
 constexpr float kInf = INFINITY;
 constexpr float kBig = 3.4e38f;
+constexpr float kMaxLightRange = 1e15f;  // range^2 and the window's sums stay far inside float
+constexpr double kMaxLightPeak = 1e30;
+constexpr float kMinLightRadius = 1e-6f;  // radius^2 stays a normal float: the inverse square stays finite   // intensity * color / radius^2: sums over lights stay finite
 }  // namespace
 
 void validate(const FogVolume& v, std::size_t index) {
@@ -103,6 +106,30 @@ void validate(const MainLight& l) {
   for (int k = 0; k < 3; ++k)
     if (!(std::isfinite(l.color[k]) && l.color[k] >= 0.0f))
       throw Error("light color must be RGB, finite and >= 0 (got " + str(l.color) + ")");
+}
+
+void validate(const LocalLight& l, std::size_t index) {
+  const VolumeChecker c{"light " + std::to_string(index) + ": "};
+  if (l.kind != LightKind::point && l.kind != LightKind::spot)
+    c.fail("kind", "must be point or spot", std::to_string(int(l.kind)));
+  c.vec("position", l.position, -kBig, kBig, "must be finite");
+  c.vec("color", l.color, 0.0f, kBig, "must be RGB, finite and >= 0");
+  c.real("intensity", l.intensity, 0.0f, false, kBig, false, "must be finite and >= 0");
+  c.real("range", l.range, 0.0f, true, kMaxLightRange, false, "must be finite and in (0, 1e15]");
+  c.real("radius", l.radius, kMinLightRadius, false, l.range, false, "must be finite and in [1e-6, range]");
+  const float brightest = std::max({l.color.x, l.color.y, l.color.z});
+  const double peak =
+      double(l.intensity) * double(brightest) * std::max(1.0, 1.0 / (double(l.radius) * double(l.radius)));
+  if (!(peak <= kMaxLightPeak))
+    c.fail("intensity",
+           "* max(color) * max(1, 1 / radius^2) must be <= 1e30 (the light's peak at its source must stay within "
+           "float range)",
+           str(peak));
+  if (l.kind != LightKind::spot) return;
+  if (!finite(l.direction) || glm::length(l.direction) == 0.0f)
+    c.fail("direction", "must be a finite non-zero vector", str(l.direction));
+  c.real("outer_angle", l.outer_angle, 0.0f, true, 90.0f, false, "must be in (0, 90] degrees");
+  c.real("inner_angle", l.inner_angle, 0.0f, false, l.outer_angle, false, "must be in [0, outer_angle] degrees");
 }
 
 void validate(const ShadowMapParams& s) {
@@ -156,6 +183,7 @@ void validate(const VolumeScene& s) {
   for (std::size_t i = 0; i < s.volumes.size(); ++i) validate(s.volumes[i], i);
   validate(s.pose);
   validate(s.light);
+  for (std::size_t i = 0; i < s.lights.size(); ++i) validate(s.lights[i], i);
   if (!std::isfinite(s.time)) throw Error("time must be finite (got " + str(s.time) + ")");
 }
 
@@ -167,6 +195,7 @@ const char* to_string(VolumeIntegrator i) {
   }
   return "unknown";
 }
+const char* to_string(LightKind k) { return k == LightKind::spot ? "spot" : "point"; }
 const char* to_string(VolumeUpsampling u) { return u == VolumeUpsampling::depth_aware ? "depth-aware" : "bilinear"; }
 const char* resolution_name(int divisor) { return divisor == 1 ? "full" : divisor == 2 ? "half" : "quarter"; }
 const char* to_string(NoiseSampling s) {
@@ -368,6 +397,55 @@ void pack_height_fog(PackedVolumeFrame& out, const FogSettings& fog, const Camer
   // An infinite ray marches to the far plane (an infinite far plane: no stretch, the tail alone).
   k[VOL_F_HEIGHT_REACH] = camera.projection == Projection::perspective_infinite_far ? 0.0f : camera.far_plane();
 }
+// The local lights that can add light (docs/volumetric.md#local-lights) after the volumes: a black
+// light, or one whose range sphere meets no visible volume (without the marched height fog, which
+// fills the view), adds exactly 0 and is left out; none left, no light code in the variant.
+static_assert(kMaxLocalLights == VOL_MAX_LIGHTS, "fogcl/volumes.h and kernels/volume_integrate.h agree");
+constexpr double kRadiansPerDegree = 3.14159265358979323846 / 180.0;
+void pack_lights(PackedVolumeFrame& out, const VolumeScene& scene) {
+  const bool height = (out.variant.features & VOL_FEATURE_HEIGHT) != 0;
+  if (out.visible.empty() && !height) return;  // no medium to glow in
+  std::vector<float> packed;
+  int spots = 0;
+  for (const LocalLight& l : scene.lights) {
+    if (l.intensity == 0.0f || std::max({l.color.x, l.color.y, l.color.z}) == 0.0f) continue;
+    bool reaches = height;
+    for (std::size_t index : out.visible) {
+      const FogVolume& v = scene.volumes[index];
+      reaches = reaches || double(glm::length(glm::dvec3(l.position) - glm::dvec3(v.center))) <
+                               double(l.range) + double(v.radius);
+    }
+    if (!reaches) continue;
+    float p[VOL_L_STRIDE] = {};
+    const auto put3 = [&](int at, const glm::vec3& x) { p[at] = x.x, p[at + 1] = x.y, p[at + 2] = x.z; };
+    put3(VOL_L_POSITION, l.position);
+    put3(VOL_L_RADIANCE, l.intensity * l.color);
+    p[VOL_L_RANGE] = l.range;
+    p[VOL_L_INV_RANGE2] = float(1.0 / (double(l.range) * double(l.range)));
+    p[VOL_L_RADIUS2] = l.radius * l.radius;
+    p[VOL_L_SPOT_SCALE] = 0.0f;  // a point light: the cone's factor is saturate(1)^2 = 1
+    p[VOL_L_SPOT_OFFSET] = 1.0f;
+    if (l.kind == LightKind::spot) {
+      put3(VOL_L_AXIS, glm::vec3(glm::normalize(glm::dvec3(l.direction))));
+      const double inner = std::cos(double(l.inner_angle) * kRadiansPerDegree);
+      const double outer = std::cos(double(l.outer_angle) * kRadiansPerDegree);
+      const double scale = 1.0 / std::max(inner - outer, 1e-4);
+      p[VOL_L_SPOT_SCALE] = float(scale);
+      p[VOL_L_SPOT_OFFSET] = float(-outer * scale);
+      ++spots;
+    }
+    packed.insert(packed.end(), p, p + VOL_L_STRIDE);
+  }
+  const std::size_t n = packed.size() / VOL_L_STRIDE;
+  if (n == 0) return;
+  if (n > VOL_MAX_LIGHTS)
+    throw Error(std::to_string(n) + " local lights reach a visible medium in this frame; at most " +
+                std::to_string(VOL_MAX_LIGHTS) + " are supported");
+  out.variant.features |= VOL_FEATURE_LIGHTS | (spots > 0 ? VOL_FEATURE_SPOT : 0);
+  out.frame[VOL_F_LIGHT_COUNT] = float(n);
+  out.frame[VOL_F_LIGHT_OFFSET] = float(out.volumes.size());
+  out.volumes.insert(out.volumes.end(), packed.begin(), packed.end());
+}
 }  // namespace
 
 PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& camera, const VolumeScene& scene,
@@ -386,6 +464,11 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
       throw Error("shadow map size must be at least 1x1 (got " + std::to_string(shadow_width) + "x" +
                   std::to_string(shadow_height) + ")");
   }
+  if (!scene.lights.empty() && settings.integrator == VolumeIntegrator::stylized)
+    throw Error("local lights need the physical integrator (got stylized, with " + std::to_string(scene.lights.size()) +
+                (scene.lights.size() == 1 ? " light" : " lights") +
+                "): the seed's accumulator has no per-sample light to add them to (VolumeSettings::integrator; "
+                "fogcl apply --integrator physical)");
   PackedVolumeFrame out;
   out.visible = visible_volumes(scene, camera, max_eye_depth);  // validates scene and camera
   if (out.visible.size() > VOL_MAX_VOLUMES)
@@ -480,6 +563,7 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
     k[VOL_F_SHADOW_BIAS] = shadow->bias;
   }
   if (settings.height_fog) pack_height_fog(out, *settings.height_fog, camera, scene.pose);
+  pack_lights(out, scene);
   return out;
 }
 
@@ -496,8 +580,9 @@ int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
   // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
   // work-items, which the march's loops prevent; the lanes instance has no image sampling.
   const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
-  // The marched height fog runs one pixel per work-item: the lanes instance does not carry it.
-  if (v.features & VOL_FEATURE_HEIGHT) return 1;
+  // The marched height fog and the local lights run one pixel per work-item: the lanes instance
+  // does not carry them.
+  if (v.features & (VOL_FEATURE_HEIGHT | VOL_FEATURE_LIGHTS)) return 1;
   return pixels_per_work_item(device) == 16 && buffer ? 16 : 1;
 }
 
@@ -522,14 +607,16 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
 // ray, its occluder, key, jitter and result (13); the staging of the noise and shadow-map helpers
 // inlined into it (10); the stylized march's per-volume entries (7), or the physical walk's state
 // (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES); with the marched height
-// fog its FOG_HP_* constants and its per-channel sums (20). Twice that for what the
+// fog its FOG_HP_* constants and its per-channel sums (20); with local lights their spans along the
+// ray and the volumes' extinctions of a segment (2 x VOL_MAX_LIGHTS + VOL_MAX_VOLUMES). Twice that for what the
 // compiler keeps besides (spilled vectors, copies): PoCL 3.1's work-group functions hold 0.9-1.15x
 // the arrays per work-item (their stack frames: 6.4-6.8 KB physical, 1.7-2.2 KB stylized at 16
 // lanes).
 std::size_t volume_march_private_bytes(const VolumeVariant& v, const DeviceTraits& device) {
   const std::size_t per_lane =
       13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES) +
-      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 20 : 0);  // the marched fog's constants and sums
+      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 20 : 0) +  // the marched fog's constants and sums
+      ((v.features & VOL_FEATURE_LIGHTS) ? 2 * VOL_MAX_LIGHTS + VOL_MAX_VOLUMES : 0);  // light spans, extinctions
   return 2 * 4 * per_lane * std::size_t(volume_march_lanes(v, device));
 }
 
