@@ -210,8 +210,8 @@ VOL_FN void vol_height_segment(VOL_REAL ta, VOL_REAL tb, VOL_REAL s_origin, VOL_
                                  : VOL_FOG(fog_height_length)(from, sb, wy, d0, k, falloff, tail);
   }
   for (int c = 0; c < ((hf & FOG_HF_RGB) ? 3 : 1); ++c)
-    VOL_FOG(fog_height_march_segment)(h, h_sun, lit, other, depth_v, hp, c, &dep_ext[c], &dep_in[c], &dep_sun[c],
-                                      &amb[c], &sun[c]);
+    VOL_FOG(fog_height_march_segment)(h, h_sun, lit, other, depth_v, hp, c, (hf & FOG_HF_SUN_START) != 0,
+                                      &dep_ext[c], &dep_in[c], &dep_sun[c], &amb[c], &sun[c]);
 }
 #endif
 

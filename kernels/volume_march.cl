@@ -13,6 +13,7 @@
  *   VOL_NOISE_IMAGE  the noise is a 3D image read with the sampler's linear filter; else a
  *                    buffer of unorm8 texels filtered by volume_noise.h
  *   VOL_LANES        target pixels per work-item: 16 on CPU devices (noise as a buffer), else 1
+ *   FOG_PORTABLE     CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
  *   VOL_HEIGHT_FEATURES  with VOL_FEATURE_HEIGHT: the marched height fog's FOG_HF_* bits
  *                    (docs/DESIGN.md §6.5); with VOL_FEATURE_HEIGHT_RGB the target holds a
  *                    coverage per channel (volume_composite.h's layout)
@@ -93,7 +94,13 @@ kernel void volume_march(global const float* depth, global const float* frame, g
 
 #elif VOL_LANES == 16
 #if VOL_FEATURES & VOL_FEATURE_HEIGHT
-/* The marched height fog's segments lane-wise: fog_math.h's 16-pixel instance (names _v). */
+/* The marched height fog's segments lane-wise: fog_math.h's 16-pixel instance (names _v), with the
+ * deferred pass's AVX-512 hooks for e^x's floor and 2^n (the same bits: fog_cpu_avx512.h). */
+#include "fog_cpu_avx512.h"
+#ifdef FOG_AVX512
+#define FOG_FLOOR fog_floor_avx512
+#define FOG_SCALE2 fog_scale2_avx512
+#endif
 #define FOG_LANES16
 #include "fog_math.h"
 #define VOL_LANE_HEIGHT
@@ -367,10 +374,16 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     const float16 ext_before[3] = {fog_ext[0], fog_ext[1], fog_ext[2]};
     if (VOL_ANY16(fogged)) {
       float16 e[3], in[3], sd[3], am[3], su[3];
-      for (int c = 0; c < 3; ++c) e[c] = fog_ext[c], in[c] = fog_in[c], sd[c] = fog_sun_depth[c], am[c] = fog_amb[c],
-                                  su[c] = fog_sun[c];
-      vol_height_segment(s0, s1, s_origin16, dir.y, d0_16, lit, adds ? sigma_t * seg : 0.0f, optical, hp,
-                         VOL_HEIGHT_FEATURES, e, in, sd, am, su);
+      for (int c = 0; c < fog_channels; ++c)
+        e[c] = fog_ext[c], in[c] = fog_in[c], sd[c] = fog_sun_depth[c], am[c] = fog_amb[c], su[c] = fog_sun[c];
+      /* Without volumes in any lane's segment (the fog alone, mostly) the fog's share of the
+       * scattering is 1 at compile time: no division for it. */
+      if (VOL_ANY16(adds))
+        vol_height_segment(s0, s1, s_origin16, dir.y, d0_16, lit, adds ? sigma_t * seg : 0.0f, optical, hp,
+                           VOL_HEIGHT_FEATURES, e, in, sd, am, su);
+      else
+        vol_height_segment(s0, s1, s_origin16, dir.y, d0_16, lit, (float16)0.0f, optical, hp, VOL_HEIGHT_FEATURES, e,
+                           in, sd, am, su);
       for (int c = 0; c < fog_channels; ++c) {
         fog_ext[c] = fogged ? e[c] : fog_ext[c];
         fog_in[c] = fogged ? in[c] : fog_in[c];

@@ -520,6 +520,7 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
   if (v.noise_sampling == NoiseSampling::image && (v.features & VOL_FEATURE_NOISE)) o += " -D VOL_NOISE_IMAGE";
   if (v.noise_sampling == NoiseSampling::buffer && (v.features & VOL_FEATURE_NOISE) && !device.cpu)
     o += " -D VOL_TEXEL_WORD_LOADS";  // kernels/volume_noise.h: GPUs only
+  if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }
 
