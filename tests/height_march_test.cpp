@@ -357,7 +357,8 @@ TEST(HeightMarchPass, ShadowedEqualsTheClosedFormWithoutSun) {
 }
 
 // Shafts (the disc blocker's shadow map) through the fog with the test scene's volumes, at half
-// resolution: the kernel against the scalar march.
+// resolution (per-channel extinction upsampled depth-aware and bilinear): the kernel against the
+// scalar march.
 TEST(HeightMarchPass, KernelMatchesScalarWithShaftsAndVolumes) {
   FOGCL_REQUIRE_DEVICE();
   const ShadowMap shadow = synthetic_shadow_map(false);
@@ -369,6 +370,8 @@ TEST(HeightMarchPass, KernelMatchesScalarWithShaftsAndVolumes) {
     vs.integrator = VolumeIntegrator::physical;
     vs.steps = 24;
     vs.height_fog = marched_fog(t.scene, seed);
+    // The per-channel coverage upsampled both ways (the other seeds: depth-aware).
+    if (seed == kRgbSeeds + 1) vs.upsampling = VolumeUpsampling::bilinear;
     ColorImage got_kernel, got_scalar;
     static VolumePass pass(*runtime());
     pass.apply(t.frame.color, t.frame.depth, got_kernel, t.frame.params, t.scene, vs, &shadow);

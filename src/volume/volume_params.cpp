@@ -528,14 +528,15 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
 // ray, its occluder, key, jitter and result (13); the staging of the noise and shadow-map helpers
 // inlined into it (10); the stylized march's per-volume entries (7), or the physical walk's state
 // (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES); with the marched height
-// fog its FOG_HP_* constants and its per-channel sums (20). Twice that for what the
+// fog its FOG_HP_* constants and its per-channel sums, their copies and the lanes' staging of
+// them (60). Twice that for what the
 // compiler keeps besides (spilled vectors, copies): PoCL 3.1's work-group functions hold 0.9-1.15x
 // the arrays per work-item (their stack frames: 6.4-6.8 KB physical, 1.7-2.2 KB stylized at 16
 // lanes).
 std::size_t volume_march_private_bytes(const VolumeVariant& v, const DeviceTraits& device) {
   const std::size_t per_lane =
       13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES) +
-      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 20 : 0);  // the marched fog's constants and sums
+      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 60 : 0);  // the marched fog's constants and sums
   return 2 * 4 * per_lane * std::size_t(volume_march_lanes(v, device));
 }
 
