@@ -33,6 +33,14 @@
 //        (the other three volumes cover part of the frame, and blocks with no coverage are copies)
 //   BM_VolumeCompositeKernel/f16/bilinear   the same kernel alone, dispatched back to back on a
 //        fixed target (the scalar march of the stylized scene): hundreds of iterations, for A/B
+//   BM_VolumeHeight/path/volumes/rgb   the march with the marched height fog (docs/DESIGN.md §6.5:
+//        falloff, sun lobe, fogged sky) at 1080p half resolution, 64 steps, physical, no shadow
+//        map; volumes 1: with the demo's four volumes; rgb 1: the extinction per channel. path 0:
+//        the OpenCL pass (march_ms: its march; on CPU devices the 16-pixel lanes), 1: the same
+//        device one pixel per work-item (CpuCodegen::one_pixel_per_work_item), 2: the scalar float
+//        pass, one thread (march_ms: the whole pass, whose composite is a small part), 3: the
+//        OpenMP peer's march (2 threads); cpu_ms: the process's CPU time per frame (all threads:
+//        on a loaded machine the wall time is the load's as much as the code's)
 // BM_VolumeDevice, BM_VolumeComposite and BM_VolumeCompositeKernel also time a 2-thread memcpy of
 // the frame's color (in its storage) and depth (memcpy2_ms) for composite_vs_memcpy2 = composite
 // time / that copy: the median of 7 after the loop, or (BM_VolumeCompositeKernel) one copy after
@@ -41,6 +49,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -210,8 +219,8 @@ void pass_counters(benchmark::State& state, double march_ms, double composite_ms
 // holds them; run() times one frame from profiling events.
 struct DeviceFrame {
   DeviceFrame(const DemoFrame& f, const VolumeScene& s, const VolumeSettings& st,
-              ColorFormat storage = ColorFormat::rgba32f)
-      : frame(f), scene(s), settings(st), pass(runtime()), max_eye(max_eye_depth(f.depth, f.params)),
+              ColorFormat storage = ColorFormat::rgba32f, const CpuCodegen& codegen = {})
+      : frame(f), scene(s), settings(st), pass(runtime(), nullptr, codegen), max_eye(max_eye_depth(f.depth, f.params)),
         input(convert(f.color, storage)) {
     pass.prepare(f.params, s, st, storage);
     const cl::Context ctx = wrap(runtime().context());
@@ -271,6 +280,66 @@ void BM_VolumeDevice(benchmark::State& state) {
   pass_counters(state, march_ms / n, composite_ms / n, d.input, f.depth);
   state.counters["steps_x_pixels_per_s"] = kSteps * low_pixels / (march_ms / n * 1e-3);
   if (width == 480) state.counters["max_err"] = max_abs_rgb_error(d.result(), reference(integrator, divisor));
+}
+
+// The marched height fog of BM_VolumeHeight: a ground fog thinning upward, the demo light's sun
+// lobe, the sky fogged; rgb: the extinction per channel (a bluish haze's proportions).
+FogSettings marched_height_fog(bool rgb) {
+  FogSettings f;
+  f.mode = FogMode::height;
+  f.color = glm::vec3(0.6f, 0.68f, 0.8f);
+  f.density = 0.08f;
+  if (rgb) f.height.extinction = glm::vec3(0.05f, 0.08f, 0.14f);
+  f.height.falloff = 0.3f;
+  f.height.base_height = 0.0f;
+  f.fog_skybox = true;
+  SunLobe sun;
+  sun.direction = demo_light().direction;
+  sun.color = glm::vec3(1.2f, 1.0f, 0.8f);
+  sun.exponent = 8.0f;
+  f.height.sun = sun;
+  return f;
+}
+
+void BM_VolumeHeight(benchmark::State& state) {
+  const int path = int(state.range(0));
+  const DemoFrame& f = frame(1920);
+  VolumeScene s = scene(VolumeIntegrator::physical);
+  if (!state.range(1)) s.volumes.clear();
+  VolumeSettings st = settings(VolumeIntegrator::physical, 2, false);
+  st.height_fog = marched_height_fog(state.range(2) != 0);
+  double march_ms = 0;
+  std::clock_t cpu_start = 0;  // the process's CPU time, every thread's, from the first timed frame
+  if (path <= 1) {
+    CpuCodegen codegen;
+    codegen.one_pixel_per_work_item = path == 1;
+    if (path == 1 && !runtime().is_cpu()) return state.SkipWithError("one pixel per work-item is a CPU device's choice");
+    DeviceFrame d(f, s, st, ColorFormat::rgba32f, codegen);
+    cpu_start = std::clock();
+    for (auto _ : state) {
+      const auto [m, c] = d.run();
+      march_ms += m;
+      state.SetIterationTime(m * 1e-3);
+    }
+    state.SetLabel(d.pass.last_march_options().find("VOL_LANES=16") != std::string::npos ? "lanes" : "one pixel");
+  } else {
+    std::vector<float> low;
+    cpu_start = std::clock();
+    for (auto _ : state) {
+      const auto a = std::chrono::steady_clock::now();
+      if (path == 2) {
+        benchmark::DoNotOptimize(volumes_scalar<float>(f.color, f.depth, f.params, s, st).low.data());
+      } else {
+        bench::openmp_simd_march(f.color, f.depth, f.params, s, st, 2, low);
+      }
+      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count();
+      march_ms += ms;
+      state.SetIterationTime(ms * 1e-3);
+    }
+  }
+  state.counters["march_ms"] = march_ms / double(state.iterations());
+  // On a shared machine the wall time depends on the load; the CPU time per frame less so.
+  state.counters["cpu_ms"] = double(std::clock() - cpu_start) * 1e3 / CLOCKS_PER_SEC / double(state.iterations());
 }
 
 void BM_VolumeComposite(benchmark::State& state) {
@@ -522,6 +591,18 @@ BENCHMARK(BM_VolumeDevice)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
+BENCHMARK(BM_VolumeHeight)
+    ->ArgNames({"path", "volumes", "rgb"})
+    ->ArgsProduct({{0, 1, 3}, {0, 1}, {0, 1}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
+BENCHMARK(BM_VolumeHeight)  // the scalar march: seconds a frame
+    ->ArgNames({"path", "volumes", "rgb"})
+    ->ArgsProduct({{2}, {0, 1}, {0}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 BENCHMARK(BM_VolumeComposite)
     ->ArgNames({"integrator", "f16", "bilinear", "sparse"})
     ->ArgsProduct({{0, 1}, {0, 1}, {0, 1}, {0}})

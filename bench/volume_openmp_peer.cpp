@@ -33,10 +33,10 @@ std::size_t openmp_simd_march(const ColorImage& in, const DepthImage& depth, con
   for (int ly = 0; ly < lh; ++ly) {
 #pragma omp simd
     for (int lx = 0; lx < lw; ++lx) {
-      float key;
+      float key, coverage[3];
       const glm::vec4 p = vol_march_pixel<float>(lx, ly, d, frame, vols, count, noise, settings.noise_size, nullptr,
                                                  scene.frame_index, integrator, v.steps, v.features, v.height_features, v.jitter,
-                                                 projection, reversed, int(v.depth_kind), &key);
+                                                 projection, reversed, int(v.depth_kind), &key, coverage);
       float* o = out + 4 * (std::size_t(ly) * lw + lx);
       o[0] = p.x;
       o[1] = p.y;

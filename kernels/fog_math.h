@@ -661,19 +661,28 @@ FOG_FN_INLINE FOG_INT FOG_NAME(fog_height_pixel)(FOG_REAL* rgb, FOG_REAL s_hit, 
  * β_ext·ΣH, the in-scattering depths β_in·ΣH and β_in·ΣH_sun, and the ambient and sun fractions
  * Σ e^(-β_in τ)·(1 - e^(-β_in H_i)) (the sun's times v), whose sums over the segments telescope to
  * §6.2's J and J_sun: with v = 1 everywhere the march is the closed form, whatever the segments.
- * other: the optical depth of other media in the segment (0: none), depth_other: theirs in front. */
+ * other: the optical depth of other media in the segment (0: none), depth_other: theirs in front.
+ * sun_apart == 0 (no sun start: h_sun == h in every segment, so the sun's depths are the
+ * ambient's) takes the sun's exponentials from the ambient's: the same values, half the work. */
 FOG_FN_INLINE void FOG_NAME(fog_height_march_segment)(FOG_REAL h, FOG_REAL h_sun, FOG_REAL v, FOG_REAL other,
-                                                      FOG_REAL depth_other, const FOG_HP_T* p, int c,
+                                                      FOG_REAL depth_other, const FOG_HP_T* p, int c, int sun_apart,
                                                       FOG_REAL* depth_ext, FOG_REAL* depth_in, FOG_REAL* depth_sun,
                                                       FOG_REAL* ambient, FOG_REAL* sun) {
   FOG_REAL b_in = (FOG_REAL)p[FOG_HP_IN + c];
-  FOG_REAL d_in = FOG_NAME(fog_height_depth)(b_in, h), d_sun = FOG_NAME(fog_height_depth)(b_in, h_sun);
+  FOG_REAL d_in = FOG_NAME(fog_height_depth)(b_in, h), d_sun = d_in;
   /* Other media in the segment (fog volumes, optical depth `other` > 0, never on an infinite tail)
    * take their share of its scattering: the fog's is d / (d + other) of 1 - e^(-(d + other)). */
   FOG_REAL share = other > (FOG_REAL)0 ? d_in / (d_in + other) : (FOG_REAL)1;
-  FOG_REAL share_sun = other > (FOG_REAL)0 ? d_sun / (d_sun + other) : (FOG_REAL)1;
-  *ambient = fma(FOG_EXP_NEG(-(*depth_in + depth_other)) * share, -FOG_EXPM1(-(d_in + other)), *ambient);
-  *sun = fma(v * FOG_EXP_NEG(-(*depth_sun + depth_other)) * share_sun, -FOG_EXPM1(-(d_sun + other)), *sun);
+  FOG_REAL front = FOG_EXP_NEG(-(*depth_in + depth_other)), scattered = -FOG_EXPM1(-(d_in + other));
+  FOG_REAL share_sun = share, front_sun = front, scattered_sun = scattered;
+  if (sun_apart) {
+    d_sun = FOG_NAME(fog_height_depth)(b_in, h_sun);
+    share_sun = other > (FOG_REAL)0 ? d_sun / (d_sun + other) : (FOG_REAL)1;
+    front_sun = FOG_EXP_NEG(-(*depth_sun + depth_other));
+    scattered_sun = -FOG_EXPM1(-(d_sun + other));
+  }
+  *ambient = fma(front * share, scattered, *ambient);
+  *sun = fma(v * front_sun * share_sun, scattered_sun, *sun);
   *depth_in = *depth_in + d_in;
   *depth_sun = *depth_sun + d_sun;
   *depth_ext = *depth_ext + FOG_NAME(fog_height_depth)((FOG_REAL)p[FOG_HP_EXT + c], h);

@@ -56,6 +56,8 @@
 #define VOL_TO_INT(x) int(x)
 #endif
 #define VOL_ANY(m) (m) /* the lanes instance: VOL_ANY16(m) */
+/* A height-fog function of fog_math.h in this instance (the lanes instance: its _v name). */
+#define VOL_FOG(name) name
 #ifdef __OPENCL_C_VERSION__
 /* any(m) of a 16-lane mask (lanes -1 / 0) as one or-reduction: PoCL lowers OpenCL's any() on 16
  * lanes to a test and a branch per lane. */

@@ -10,6 +10,8 @@
  *                    vectorises only across work-items, and this kernel's per-pixel branches
  *                    keep it from doing so), 1 elsewhere (coalesced GPU accesses)
  *   FOG_PORTABLE     CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
+ *   VOL_TARGET_RGB   the target holds a coverage per channel (the marched height fog's extinction
+ *                    differs per channel: volume_composite.h's layout); one pixel per work-item
  *   FOG_STREAMING_MIN_PIXELS  CPU devices, RGBA32F: frames of at least this many pixels are
  *                    written with non-temporal stores (0: every frame; absent: none)
  * Global size: volume_composite_global() (src/volume/volume_params.h): (ceil(width / VOL_LANES), height),
@@ -21,6 +23,9 @@
 
 #ifndef VOL_LANES
 #define VOL_LANES 1
+#endif
+#if defined(VOL_TARGET_RGB) && VOL_LANES != 1
+#error "the per-channel target is composited one pixel per work-item"
 #endif
 #if VOL_LANES == 16
 #define FOG_CLAMP_BY_SELECT /* as in deferred_fog.cl: LLVM keeps IEEE comparisons */
@@ -55,8 +60,19 @@ static inline void vol_composite_pixel(global const COLOR_T* color_in, global co
 #if VOL_DEPTH_AWARE && VOL_SCALE > 1
   rho = vol_inverse_eye_depth(depth[i], frame, FOG_PROJECTION, VOL_REVERSED_Z, VOL_DEPTH_KIND);
 #endif
+#ifdef VOL_TARGET_RGB
+  /* Each channel over its own coverage: color·T_c + P_c, T_c = 1 - A_c (fog.w: the largest A_c). */
+  size_t at[4];
+  float w[4];
+  const int normalise = vol_upsample_weights(x, y, rho, low_key, (int)frame[VOL_F_LOW_WIDTH],
+                                             (int)frame[VOL_F_LOW_HEIGHT], VOL_SCALE, VOL_DEPTH_AWARE, at, w);
+  const float4 fog = vol_upsample_taps(low, VOL_TARGET_FLOATS(1), 0, at, w, normalise, VOL_SCALE);
+  const float4 cover = vol_upsample_taps(low, VOL_TARGET_FLOATS(1), 4, at, w, normalise, VOL_SCALE);
+#else
   const float4 fog = vol_upsample(x, y, rho, low, low_key, (int)frame[VOL_F_LOW_WIDTH],
                                   (int)frame[VOL_F_LOW_HEIGHT], VOL_SCALE, VOL_DEPTH_AWARE);
+  const float4 cover = fog.wwww;
+#endif
 #ifdef FOG_COLOR_HALF
   if (fog.w == 0.0f) { /* no fog: the bits pass through (a half trip would quiet a signalling NaN) */
     vstore4(vload4(i, (global const ushort*)color_in), i, (global ushort*)color_out);
@@ -70,8 +86,8 @@ static inline void vol_composite_pixel(global const COLOR_T* color_in, global co
   }
   const float4 c = vload4(i, color_in);
 #endif
-  const float4 o = (float4)(vol_composite(c.x, fog.x, fog.w), vol_composite(c.y, fog.y, fog.w),
-                            vol_composite(c.z, fog.z, fog.w), c.w);
+  const float4 o = (float4)(vol_composite(c.x, fog.x, cover.x), vol_composite(c.y, fog.y, cover.y),
+                            vol_composite(c.z, fog.z, cover.z), c.w);
 #ifdef FOG_COLOR_HALF
   vstore_half4_rte(o, i, color_out);
   /* alpha keeps its bits (a half trip would quiet a signalling NaN) */

@@ -71,21 +71,34 @@ VOL_FN VOL_REAL vol_upsample_axis(int x, int scale, int low_size, int* i0, int* 
   return g - f0;
 }
 
-/* The target (P, A) at full-resolution pixel (x, y) of inverse eye depth rho
- * (vol_inverse_eye_depth): the 2 x 2 nearest target pixels, bilinear, or bilinear x depth
- * similarity when depth_aware. Scale 1 returns the pixel's own sample unchanged. */
-VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL* low, VOL_GLOBAL const VOL_REAL* low_key,
-                           int low_width, int low_height, int scale, int depth_aware) {
+/* The target's layout: per target pixel (P premultiplied RGB, A), 4 floats, and where the marched
+ * fog's extinction differs per channel (VOL_FEATURE_HEIGHT_RGB; the composite's VOL_TARGET_RGB)
+ * the coverage per channel (A_r, A_g, A_b, 0) after it, 8 floats, A then being their largest
+ * (what tells a pixel with fog from one without). */
+#define VOL_TARGET_FLOATS(rgb) ((rgb) ? 8 : 4)
+
+/* The upsampling of the target at full-resolution pixel (x, y) of inverse eye depth rho
+ * (vol_inverse_eye_depth): the 2 x 2 nearest target pixels (their indices in at[4]) and their
+ * weights w[4], bilinear, or bilinear x depth similarity when depth_aware; returns whether the
+ * weights' sum is to be normalised (vol_upsample_taps). Scale 1 gives the pixel's own sample,
+ * weight 1. */
+VOL_FN int vol_upsample_weights(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL* low_key, int low_width,
+                                int low_height, int scale, int depth_aware, size_t* at, VOL_REAL* w) {
   if (scale == 1) {
-    const size_t i = (size_t)y * (size_t)low_width + (size_t)x;
-    return VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3));
+    at[0] = at[1] = at[2] = at[3] = (size_t)y * (size_t)low_width + (size_t)x;
+    w[0] = (VOL_REAL)1;
+    w[1] = w[2] = w[3] = (VOL_REAL)0;
+    return 0;
   }
   int x0, x1, y0, y1;
   const VOL_REAL fx = VOL_T(vol_upsample_axis)(x, scale, low_width, &x0, &x1);
   const VOL_REAL fy = VOL_T(vol_upsample_axis)(y, scale, low_height, &y0, &y1);
   const int xs[4] = {x0, x1, x0, x1}, ys[4] = {y0, y0, y1, y1};
-  VOL_REAL w[4] = {((VOL_REAL)1 - fx) * ((VOL_REAL)1 - fy), fx * ((VOL_REAL)1 - fy), ((VOL_REAL)1 - fx) * fy,
-                   fx * fy};
+  for (int k = 0; k < 4; ++k) at[k] = (size_t)ys[k] * (size_t)low_width + (size_t)xs[k];
+  w[0] = ((VOL_REAL)1 - fx) * ((VOL_REAL)1 - fy);
+  w[1] = fx * ((VOL_REAL)1 - fy);
+  w[2] = ((VOL_REAL)1 - fx) * fy;
+  w[3] = fx * fy;
   /* Depth-aware weights are bilinear[k] / e[k], e[k] = max(depth difference, EPS) in [0.01, 1],
    * here scaled by e0 e1 e2 e3 (the sum is normalised): products that cannot overflow or
    * underflow instead of 4 divisions, and one reciprocal of their sum. A pixel whose four
@@ -97,7 +110,7 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL
   if (depth_aware) {
     VOL_REAL d[4];
     for (int k = 0; k < 4; ++k) {
-      d[k] = VOL_T(vol_depth_difference)(rho, (VOL_REAL)low_key[(size_t)ys[k] * (size_t)low_width + (size_t)xs[k]]);
+      d[k] = VOL_T(vol_depth_difference)(rho, (VOL_REAL)low_key[at[k]]);
       normalise |= d[k] > (VOL_REAL)VOL_UPSAMPLE_EPS; /* d is never NaN */
     }
     if (normalise) {
@@ -110,14 +123,33 @@ VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL
       w[3] = w[3] * (e[2] * e01);
     }
   }
+  return normalise;
+}
+
+/* The 4 floats from `offset` of each target pixel (stride floats apart) under the weights of
+ * vol_upsample_weights. One weight of 1 (scale 1) returns its tap unchanged. */
+VOL_FN VOL_V4 vol_upsample_taps(VOL_GLOBAL const VOL_REAL* low, int stride, int offset, const size_t* at,
+                                const VOL_REAL* w, int normalise, int scale) {
   VOL_V4 tap[4];
-  for (int k = 0; k < 4; ++k) {
-    const size_t i = (size_t)ys[k] * (size_t)low_width + (size_t)xs[k];
-    tap[k] = VOL_MAKE4(VOL_P(low, 4 * i), VOL_P(low, 4 * i + 1), VOL_P(low, 4 * i + 2), VOL_P(low, 4 * i + 3));
+  for (int k = 0; k < (scale == 1 ? 1 : 4); ++k) {
+    const size_t i = (size_t)stride * at[k] + (size_t)offset;
+    tap[k] = VOL_MAKE4(VOL_P(low, i), VOL_P(low, i + 1), VOL_P(low, i + 2), VOL_P(low, i + 3));
   }
+  if (scale == 1) return tap[0];
   /* Row by row, then normalised: two short chains, and the CPU lanes' division overlaps them. */
   const VOL_V4 sum = VOL_T(vol_fma4)(tap[1], w[1], tap[0] * w[0]) + VOL_T(vol_fma4)(tap[3], w[3], tap[2] * w[2]);
   return normalise ? sum * ((VOL_REAL)1 / ((w[0] + w[1]) + (w[2] + w[3]))) : sum;
+}
+
+/* The target (P, A) of a target of 4 floats per pixel at full-resolution pixel (x, y) of inverse
+ * eye depth rho: vol_upsample_weights' taps. Scale 1 returns the pixel's own sample unchanged. */
+VOL_FN VOL_V4 vol_upsample(int x, int y, VOL_REAL rho, VOL_GLOBAL const VOL_REAL* low, VOL_GLOBAL const VOL_REAL* low_key,
+                           int low_width, int low_height, int scale, int depth_aware) {
+  size_t at[4];
+  VOL_REAL w[4];
+  const int normalise =
+      VOL_T(vol_upsample_weights)(x, y, rho, low_key, low_width, low_height, scale, depth_aware, at, w);
+  return VOL_T(vol_upsample_taps)(low, 4, 0, at, w, normalise, scale);
 }
 
 /* One channel over the fog (docs/volumetric.md §Resolution, upsampling, composite): P + c (1 - A),

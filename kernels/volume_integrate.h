@@ -12,6 +12,8 @@
 #define VOL_FEATURE_ADAPTIVE 32      /* stylized: the seed's adaptive stepping */
 #define VOL_FEATURE_HEIGHT 64        /* physical: the height fog marched (docs/DESIGN.md §6.5); its
                                       * FOG_HF_* bits are VOL_HEIGHT_FEATURES */
+#define VOL_FEATURE_HEIGHT_RGB 128   /* ... whose extinction differs per channel: the target holds a
+                                      * coverage per channel (VOL_TARGET_RGB) */
 #define VOL_MAX_VOLUMES 32           /* visible volumes per frame (the host checks) */
 #define VOL_FEATURE_LIGHTS 1024      /* physical: local lights (VOL_F_LIGHT_COUNT of them), one pixel per work-item */
 #define VOL_FEATURE_SPOT 2048        /* ... some of them spot lights: the cone's factor */
@@ -198,6 +200,33 @@ VOL_FN VOL_REAL vol_segment_weight(VOL_REAL sigma_t, VOL_REAL seg, VOL_REAL dept
  * which the caller takes as b exactly). j and n are small integers, exact as reals. */
 VOL_FN VOL_REAL vol_segment_start(VOL_REAL a, VOL_REAL length, VOL_REAL j, VOL_REAL n) { return a + length * j / n; }
 
+#if !defined(VOL_LANE_INSTANCE) || defined(VOL_LANE_HEIGHT) /* the lanes' with the marched fog only */
+/* The marched height fog's segment [ta, tb] of the ray (tb = +inf: the infinite tail), visibility
+ * lit, other media's optical depth `other` in it and depth_v in front: fog_height_march_segment per
+ * channel, H and H_sun from §6.2's fog_height_length (heights from d0 + s wy, s = t + s_origin).
+ * Both instances: the lanes kernel runs it on 16 rays' segments at once. */
+VOL_FN void vol_height_segment(VOL_REAL ta, VOL_REAL tb, VOL_REAL s_origin, VOL_REAL wy, VOL_REAL d0,
+                               VOL_REAL lit, VOL_REAL other, VOL_REAL depth_v, const VOL_U* hp, int hf,
+                               VOL_REAL* dep_ext, VOL_REAL* dep_in, VOL_REAL* dep_sun, VOL_REAL* amb,
+                               VOL_REAL* sun) {
+  const int falloff = (hf & FOG_HF_FALLOFF) != 0;
+  const VOL_INT tail = !(tb < (VOL_REAL)INFINITY);
+  const VOL_REAL sa = ta + s_origin, sb = tail ? (VOL_REAL)INFINITY : tb + s_origin;
+  const VOL_REAL k = (VOL_REAL)hp[FOG_HP_K];
+  const VOL_REAL h = VOL_FOG(fog_height_length)(sa, sb, wy, d0, k, falloff, tail);
+  VOL_REAL h_sun = h;
+  if (hf & FOG_HF_SUN_START) {
+    const VOL_REAL from = fmax(sa, (VOL_REAL)hp[FOG_HP_SUN_START]);
+    h_sun = !(tail | (sb > from)) ? (VOL_REAL)0
+            : from == sa         ? h
+                                 : VOL_FOG(fog_height_length)(from, sb, wy, d0, k, falloff, tail);
+  }
+  for (int c = 0; c < ((hf & FOG_HF_RGB) ? 3 : 1); ++c)
+    VOL_FOG(fog_height_march_segment)(h, h_sun, lit, other, depth_v, hp, c, (hf & FOG_HF_SUN_START) != 0,
+                                      &dep_ext[c], &dep_in[c], &dep_sun[c], &amb[c], &sun[c]);
+}
+#endif
+
 #ifndef VOL_LANE_INSTANCE
 /* physical: the piece of the ray that starts at a and ends at the next sphere boundary *b (+inf:
  * none left), and the volumes of `hit` that cover all of it. */
@@ -286,15 +315,16 @@ VOL_FN VOL_V3 vol_light_scatter(VOL_REAL cos_theta, const VOL_REAL* each, VOL_UI
 }
 
 /* The local lights' in-scattered radiance over the segment [s0, s1] of a ray, extinction sigma_t
- * in it (constant), optical depth `depth` before it. For each light whose span meets the segment,
+ * in it (constant), optical depth `depth` before it, each per channel (`channels` 3: the marched
+ * fog's extinction differs per channel; 1: element 0 serves three). For each light whose span meets the segment,
  * its part [a, b] is cut into pieces of at most VOL_LIGHT_ANGLE_STEP as seen from the light; on a
  * piece [ua, ub] (u = t - t0, t0 the ray's closest approach, c = h^2 + radius^2) the inverse
  * square is integrated exactly, int du / (u^2 + c) = (angle subtended) / sqrt(c), and the
  * transmittance by its mean over the piece, T(ua) (1 - e^(-sigma_t (ub - ua))) / (sigma_t (ub - ua));
  * the window, the cone and the phase are taken at the piece's angular midpoint. A sample at the
  * light or a ray through it is finite: c >= radius^2 > 0. */
-VOL_FN VOL_V3 vol_lights_segment(VOL_V3 origin, VOL_V3 dir, VOL_REAL s0, VOL_REAL s1, VOL_REAL sigma_t, VOL_REAL depth,
-                                 const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols, int count,
+VOL_FN VOL_V3 vol_lights_segment(VOL_V3 origin, VOL_V3 dir, VOL_REAL s0, VOL_REAL s1, const VOL_REAL* sigma_t,
+                                 const VOL_REAL* depth, int channels, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols, int count,
                                  VOL_V3 fog_scatter, VOL_GLOBAL const float* lights, int n_lights,
                                  const VOL_REAL* l_in, const VOL_REAL* l_out, int features) {
   VOL_V3 sum = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
@@ -319,9 +349,13 @@ VOL_FN VOL_V3 vol_lights_segment(VOL_V3 origin, VOL_V3 dir, VOL_REAL s0, VOL_REA
       x1 = j + 1 == n ? xb : fmin(fmax(tan(phi_a + piece * (VOL_REAL)(j + 1)), x0), xb);
       const VOL_REAL xm = fmin(fmax(tan(phi_a + piece * ((VOL_REAL)j + (VOL_REAL)0.5f)), x0), x1);
       const VOL_REAL ta = t0 + x0 * sc, len = (x1 - x0) * sc, tm = t0 + xm * sc;
-      const VOL_REAL thick = sigma_t * len;
-      const VOL_REAL mean = thick > (VOL_REAL)0 ? -expm1(-thick) / thick : (VOL_REAL)1;
-      const VOL_REAL transmittance = exp(-(depth + sigma_t * fmax(ta - s0, (VOL_REAL)0))) * mean;
+      VOL_REAL transmittance[3];
+      for (int c = 0; c < channels; ++c) {
+        const VOL_REAL thick = sigma_t[c] * len;
+        const VOL_REAL mean = thick > (VOL_REAL)0 ? -expm1(-thick) / thick : (VOL_REAL)1;
+        transmittance[c] = exp(-(depth[c] + sigma_t[c] * fmax(ta - s0, (VOL_REAL)0))) * mean;
+      }
+      if (channels == 1) transmittance[1] = transmittance[2] = transmittance[0];
       const VOL_V3 to_light = pos - (origin + dir * tm);
       const VOL_REAL d2 = dot(to_light, to_light);
       const VOL_REAL w = (VOL_REAL)1 - d2 * VOL_P(light, VOL_L_INV_RANGE2);
@@ -334,8 +368,9 @@ VOL_FN VOL_V3 vol_lights_segment(VOL_V3 origin, VOL_V3 dir, VOL_REAL s0, VOL_REA
         const VOL_REAL f = vol_saturate(cos_axis * VOL_P(light, VOL_L_SPOT_SCALE) + VOL_P(light, VOL_L_SPOT_OFFSET));
         cone = f * f;
       }
-      light_sum = light_sum + vol_light_scatter(cos_theta, each, mask, vols, count, fog_scatter) *
-                                  (w * w * cone * transmittance);
+      const VOL_V3 scatter = vol_light_scatter(cos_theta, each, mask, vols, count, fog_scatter) * (w * w * cone);
+      light_sum = light_sum + VOL_MAKE3(scatter.x * transmittance[0], scatter.y * transmittance[1],
+                                        scatter.z * transmittance[2]);
     }
     sum = sum + VOL_P3(light, VOL_L_RADIANCE) * mass * light_sum;
   }
@@ -347,22 +382,22 @@ VOL_FN VOL_V3 vol_lights_segment(VOL_V3 origin, VOL_V3 dir, VOL_REAL s0, VOL_REA
  * ray origin's distance). An infinite ray (a fogged sky without cut-off) marches to `reach` (or
  * s0) and sets *infinite: the closed form's tail [*t1, inf) follows. Returns 0 where the ray has
  * no fog (sky unfogged, empty stretch). */
-VOL_FN int vol_height_stretch(VOL_REAL t_scene, VOL_REAL s_origin, VOL_REAL reach, const VOL_REAL* hp, int hf,
+VOL_FN int vol_height_stretch(VOL_REAL t_scene, VOL_REAL s_origin, VOL_REAL reach, const VOL_U* hp, int hf,
                               VOL_REAL* t0, VOL_REAL* t1, int* infinite) {
-  const VOL_REAL s0 = (hf & FOG_HF_START) ? hp[FOG_HP_START] : (VOL_REAL)0;
+  const VOL_REAL s0 = (hf & FOG_HF_START) ? (VOL_REAL)hp[FOG_HP_START] : (VOL_REAL)0;
   VOL_REAL s1;
   *infinite = 0;
   if (!(t_scene < (VOL_REAL)INFINITY)) {
     if (!(hf & FOG_HF_SKYBOX)) return 0;
     if (hf & FOG_HF_CUTOFF) {
-      s1 = hp[FOG_HP_CUTOFF];
+      s1 = (VOL_REAL)hp[FOG_HP_CUTOFF];
     } else {
       *infinite = 1;
       s1 = fmax(reach, s0);
     }
   } else {
     s1 = t_scene + s_origin;
-    if (hf & FOG_HF_CUTOFF) s1 = fmin(s1, hp[FOG_HP_CUTOFF]);
+    if (hf & FOG_HF_CUTOFF) s1 = fmin(s1, (VOL_REAL)hp[FOG_HP_CUTOFF]);
   }
   if (!*infinite && !(s1 > s0)) return 0;
   *t0 = s0 - s_origin;
@@ -370,30 +405,74 @@ VOL_FN int vol_height_stretch(VOL_REAL t_scene, VOL_REAL s_origin, VOL_REAL reac
   return 1;
 }
 
-/* The marched height fog's segment [ta, tb] of the ray (tb = +inf: the infinite tail), visibility
- * lit, other media's optical depth `other` in it and depth_v in front: fog_height_march_segment per
- * channel, H and H_sun from §6.2's fog_height_length (heights from d0 + s wy, s = t + s_origin). */
-VOL_FN void vol_height_segment(VOL_REAL ta, VOL_REAL tb, VOL_REAL s_origin, VOL_REAL wy, VOL_REAL d0,
-                               VOL_REAL lit, VOL_REAL other, VOL_REAL depth_v, const VOL_REAL* hp, int hf,
-                               VOL_REAL* dep_ext, VOL_REAL* dep_in, VOL_REAL* dep_sun, VOL_REAL* amb,
-                               VOL_REAL* sun) {
-  const int falloff = (hf & FOG_HF_FALLOFF) != 0, tail = !(tb < (VOL_REAL)INFINITY);
-  const VOL_REAL sa = ta + s_origin, sb = tail ? (VOL_REAL)INFINITY : tb + s_origin;
-  const VOL_REAL h = fog_height_length(sa, sb, wy, d0, hp[FOG_HP_K], falloff, tail);
-  VOL_REAL h_sun = h;
-  if (hf & FOG_HF_SUN_START) {
-    const VOL_REAL from = fmax(sa, hp[FOG_HP_SUN_START]);
-    h_sun = !(tail || sb > from) ? (VOL_REAL)0
-            : from == sa         ? h
-                                 : fog_height_length(from, sb, wy, d0, hp[FOG_HP_K], falloff, tail);
+/* The marched height fog's part of a ray (docs/DESIGN.md §6.5): the ray origin's distance
+ * *s_origin, its height above the base *d0, and the fog's stretch added to the ray's pieces as
+ * volume `count` (t_in, t_out, *hit, *start), where it has one; an infinite ray (*infinite) ends
+ * with the closed form's tail from *tail_from, behind every volume. */
+VOL_FN void vol_height_ray(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL t_per_eye,
+                           VOL_GLOBAL const float* frame, const VOL_U* hp, int hf, int count, VOL_REAL* t_in,
+                           VOL_REAL* t_out, VOL_UINT* hit, VOL_REAL* start, VOL_REAL* s_origin, VOL_REAL* d0,
+                           VOL_REAL* tail_from, int* infinite) {
+  *s_origin = VOL_P(frame, VOL_F_NEAR) * t_per_eye;
+  *d0 = origin.y - *s_origin * dir.y - VOL_P(frame, VOL_F_HEIGHT_BASE);
+  *tail_from = (VOL_REAL)0;
+  *infinite = 0;
+  VOL_REAL f0, f1;
+  if (!vol_height_stretch(t_scene, *s_origin, VOL_P(frame, VOL_F_HEIGHT_REACH) * t_per_eye, hp, hf, &f0, &f1,
+                          infinite))
+    return;
+  if (*infinite)
+    for (int i = 0; i < count; ++i)
+      if ((*hit >> i) & 1u) f1 = fmax(f1, t_out[i]); /* the tail starts behind every volume */
+  *tail_from = f1;
+  if (f1 > f0) {
+    t_in[count] = f0;
+    t_out[count] = f1;
+    *hit |= 1u << count;
+    *start = fmin(*start, f0);
   }
-  for (int c = 0; c < ((hf & FOG_HF_RGB) ? 3 : 1); ++c)
-    fog_height_march_segment(h, h_sun, lit, other, depth_v, hp, c, &dep_ext[c], &dep_in[c], &dep_sun[c], &amb[c],
-                             &sun[c]);
+}
+
+/* The marched height fog's end of a ray (docs/DESIGN.md §6.5): an infinite ray's tail [tail_from,
+ * inf) as one more segment (visibility at its start), then P += F·ambient + S·λ·sun onto i (the
+ * volumes' light) and the coverage 1 - e^(-(volumes' depth + the fog's β_ext·H)) per channel in
+ * coverage[0..2] (one value where the extinction is grey); returns (P, coverage[0]). The sums are
+ * the fog's per-channel state of vol_physical (channel 0 alone where FOG_HF_RGB is off). */
+VOL_FN VOL_V4 vol_height_finish(VOL_V3 origin, VOL_V3 dir, VOL_REAL tail_from, int infinite, VOL_REAL s_origin,
+                                VOL_REAL d0, VOL_REAL depth, VOL_V3 i, const VOL_U* hp, int hf,
+                                VOL_GLOBAL const float* frame, VOL_GLOBAL const float* shadow_map, int features,
+                                VOL_REAL* fog_ext, VOL_REAL* fog_in, VOL_REAL* fog_sun_depth, VOL_REAL* fog_amb,
+                                VOL_REAL* fog_sun, VOL_REAL* coverage) {
+  if (infinite) {
+    const VOL_V3 p = origin + dir * tail_from;
+    const VOL_REAL lit = (features & VOL_FEATURE_SHADOW)
+                             ? vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)
+                             : (VOL_REAL)1;
+    vol_height_segment(tail_from, (VOL_REAL)INFINITY, s_origin, dir.y, d0, lit, (VOL_REAL)0, depth, hp, hf, fog_ext,
+                       fog_in, fog_sun_depth, fog_amb, fog_sun);
+  }
+  if (!(hf & FOG_HF_RGB)) {
+    fog_ext[1] = fog_ext[2] = fog_ext[0];
+    fog_amb[1] = fog_amb[2] = fog_amb[0];
+    fog_sun[1] = fog_sun[2] = fog_sun[0];
+  }
+  VOL_REAL lobe = (VOL_REAL)0;
+  if (hf & FOG_HF_SUN) {
+    const VOL_V3 l = VOL_P3(frame, VOL_F_HEIGHT_SUN);
+    lobe = fog_sun_lobe(fog_sun_q(dir.x, dir.y, dir.z, l.x, l.y, l.z), (VOL_REAL)hp[FOG_HP_SUN_EXP]);
+  }
+  VOL_REAL p[3] = {i.x, i.y, i.z};
+  for (int c = 0; c < 3; ++c) {
+    p[c] += (VOL_REAL)hp[FOG_HP_FOG + c] * fog_amb[c] +
+            ((hf & FOG_HF_SUN) ? (VOL_REAL)hp[FOG_HP_SUN + c] * lobe * fog_sun[c] : (VOL_REAL)0);
+    coverage[c] = -expm1(-(depth + fog_ext[c]));
+  }
+  return VOL_MAKE4(p[0], p[1], p[2], coverage[0]);
 }
 
 /* physical (Hillaire 2015, "Physically Based and Unified Volumetric Rendering in Frostbite"):
- * all volumes of the ray at once, returns (in-scattered I, premultiplied; coverage 1 - T).
+ * all volumes of the ray at once, returns (in-scattered I, premultiplied; coverage 1 - T), and the
+ * coverage per channel in coverage[0..2] (the marched fog's extinction may differ per channel).
  * The ray's covered stretch is cut at every sphere boundary into pieces where the same volumes
  * overlap; the steps are shared out in proportion to length (at least one per piece), so the
  * segments tile each sphere's chord [front, min(back, t_scene)] exactly. Per segment of length
@@ -410,7 +489,7 @@ VOL_FN void vol_height_segment(VOL_REAL ta, VOL_REAL tb, VOL_REAL s_origin, VOL_
 VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL t_per_eye, VOL_REAL jitter,
                            VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
                            VOL_NOISE_PARAM, int noise_size, VOL_GLOBAL const float* shadow_map,
-                           int steps, int features, int height_features, int riemann) {
+                           int steps, int features, int height_features, int riemann, VOL_REAL* coverage) {
   VOL_REAL t_in[VOL_MAX_VOLUMES], t_out[VOL_MAX_VOLUMES], start;
   VOL_UINT hit = vol_physical_hits(origin, dir, t_scene, vols, count, t_in, t_out, &start);
   VOL_REAL i_r = 0, i_g = 0, i_b = 0, depth = 0;
@@ -419,30 +498,18 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
   const int height = (features & VOL_FEATURE_HEIGHT) != 0, hf = height_features;
   const VOL_UINT fog_bit = height ? 1u << count : 0u;
   const int walked = height ? count + 1 : count;
-  VOL_REAL hp[FOG_HP_COUNT], fog_ext[3] = {0, 0, 0}, fog_in[3] = {0, 0, 0}, fog_sun_depth[3] = {0, 0, 0};
+  VOL_U hp[FOG_HP_COUNT];
+  VOL_REAL fog_ext[3] = {0, 0, 0}, fog_in[3] = {0, 0, 0}, fog_sun_depth[3] = {0, 0, 0};
   VOL_REAL fog_amb[3] = {0, 0, 0}, fog_sun[3] = {0, 0, 0};
   VOL_REAL s_origin = 0, wy = 0, d0 = 0, tail_from = 0;
   int infinite = 0;
   if (height) {
-    for (int k = 0; k < FOG_HP_COUNT; ++k) hp[k] = VOL_P(frame, VOL_F_HEIGHT_P + k);
-    s_origin = VOL_P(frame, VOL_F_NEAR) * t_per_eye;
+    for (int k = 0; k < FOG_HP_COUNT; ++k) hp[k] = VOL_PU(frame, VOL_F_HEIGHT_P + k);
+    vol_height_ray(origin, dir, t_scene, t_per_eye, frame, hp, hf, count, t_in, t_out, &hit, &start, &s_origin, &d0,
+                   &tail_from, &infinite);
     wy = dir.y;
-    d0 = origin.y - s_origin * dir.y - VOL_P(frame, VOL_F_HEIGHT_BASE);
-    VOL_REAL f0, f1;
-    if (vol_height_stretch(t_scene, s_origin, VOL_P(frame, VOL_F_HEIGHT_REACH) * t_per_eye, hp, hf, &f0, &f1,
-                           &infinite)) {
-      if (infinite)
-        for (int i = 0; i < count; ++i)
-          if ((hit >> i) & 1u) f1 = fmax(f1, t_out[i]); /* the tail starts behind every volume */
-      tail_from = f1;
-      if (f1 > f0) {
-        t_in[count] = f0;
-        t_out[count] = f1;
-        hit |= fog_bit;
-        start = fmin(start, f0);
-      }
-    }
   }
+  coverage[0] = coverage[1] = coverage[2] = (VOL_REAL)0;
   if (hit == 0u && !infinite) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   /* Local lights: their spans along the ray once; each[] the volumes' extinctions of a segment. */
   const int n_lights = (features & VOL_FEATURE_LIGHTS) ? (int)VOL_P(frame, VOL_F_LIGHT_COUNT) : 0;
@@ -450,6 +517,8 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
   VOL_REAL l_in[VOL_MAX_LIGHTS], l_out[VOL_MAX_LIGHTS], each[VOL_MAX_VOLUMES];
   if (n_lights > 0) vol_light_spans(origin, dir, fmin(start, (VOL_REAL)0), t_scene, lights, n_lights, l_in, l_out);
   const VOL_V3 no_fog = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  /* The fog's extinction per channel (VOL_FEATURE_HEIGHT_RGB) dims the volumes' light per channel. */
+  const int channels = (features & VOL_FEATURE_HEIGHT_RGB) ? 3 : 1;
   VOL_REAL phase[VOL_MAX_VOLUMES];
   vol_physical_phases(dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR)), vols, count, phase);
   const VOL_REAL covered = hit != 0u ? vol_covered(t_in, t_out, hit, walked, start) : (VOL_REAL)0;
@@ -476,7 +545,7 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
         if (height && (mask & fog_bit)) {
           /* Extinctions add: the volumes' light shares the segment with the fog's (§6.5). */
           const VOL_REAL other = sigma_t > (VOL_REAL)0 ? sigma_t * seg : (VOL_REAL)0;
-          const VOL_REAL ext_before = fog_ext[0];
+          const VOL_REAL ext_before[3] = {fog_ext[0], fog_ext[1], fog_ext[2]};
           const VOL_REAL in_before[3] = {fog_in[0], fog_in[1], fog_in[2]};
           vol_height_segment(s0, s1, s_origin, wy, d0, lit, other, depth, hp, hf, fog_ext, fog_in, fog_sun_depth,
                              fog_amb, fog_sun);
@@ -486,29 +555,45 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
             const int rgb = (hf & FOG_HF_RGB) != 0;
             const VOL_V3 fog_scatter = VOL_MAKE3(fog_in[0] - in_before[0], rgb ? fog_in[1] - in_before[1] : fog_in[0] - in_before[0],
                                                  rgb ? fog_in[2] - in_before[2] : fog_in[0] - in_before[0]) / seg;
-            const VOL_REAL sigma_all = (sigma_t > (VOL_REAL)0 ? sigma_t : (VOL_REAL)0) + (fog_ext[0] - ext_before) / seg;
-            const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sigma_all, depth + ext_before, each, mask, vols,
+            VOL_REAL sigma_all[3], depth_all[3];
+            for (int c = 0; c < channels; ++c) {
+              sigma_all[c] = (sigma_t > (VOL_REAL)0 ? sigma_t : (VOL_REAL)0) + (fog_ext[c] - ext_before[c]) / seg;
+              depth_all[c] = depth + ext_before[c];
+            }
+            const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sigma_all, depth_all, channels, each, mask, vols,
                                                 count, fog_scatter, lights, n_lights, l_in, l_out, features);
             i_r += l.x;
             i_g += l.y;
             i_b += l.z;
           }
           if (!(sigma_t > (VOL_REAL)0)) continue;
-          const VOL_REAL scatter =
-              vol_segment_weight(sigma_t + (fog_ext[0] - ext_before) / seg, seg, depth + ext_before, riemann);
-          i_r += source.x * scatter;
-          i_g += source.y * scatter;
-          i_b += source.z * scatter;
+          VOL_REAL scatter[3];
+          for (int c = 0; c < channels; ++c)
+            scatter[c] = vol_segment_weight(sigma_t + (fog_ext[c] - ext_before[c]) / seg, seg, depth + ext_before[c],
+                                            riemann);
+          if (channels == 1) scatter[1] = scatter[2] = scatter[0];
+          i_r += source.x * scatter[0];
+          i_g += source.y * scatter[1];
+          i_b += source.z * scatter[2];
           depth += sigma_t * seg;
           continue;
         }
         if (!(sigma_t > (VOL_REAL)0)) continue;
         if (n_lights > 0) {
-          const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sigma_t, height ? depth + fog_ext[0] : depth, each,
-                                              mask, vols, count, no_fog, lights, n_lights, l_in, l_out, features);
+          VOL_REAL sig3[3], depth3[3];
+          for (int c = 0; c < channels; ++c) sig3[c] = sigma_t, depth3[c] = height ? depth + fog_ext[c] : depth;
+          const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sig3, depth3, channels, each, mask, vols, count, no_fog,
+                                              lights, n_lights, l_in, l_out, features);
           i_r += l.x;
           i_g += l.y;
           i_b += l.z;
+        }
+        if (height && channels == 3) {
+          i_r += source.x * vol_segment_weight(sigma_t, seg, depth + fog_ext[0], riemann);
+          i_g += source.y * vol_segment_weight(sigma_t, seg, depth + fog_ext[1], riemann);
+          i_b += source.z * vol_segment_weight(sigma_t, seg, depth + fog_ext[2], riemann);
+          depth += sigma_t * seg;
+          continue;
         }
         const VOL_REAL scatter = vol_segment_weight(sigma_t, seg, height ? depth + fog_ext[0] : depth, riemann);
         i_r += source.x * scatter;
@@ -519,29 +604,12 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
     }
     a = b;
   }
-  if (!height) return VOL_MAKE4(i_r, i_g, i_b, -expm1(-depth));
-  if (infinite) {
-    const VOL_V3 p = origin + dir * tail_from;
-    const VOL_REAL lit = (features & VOL_FEATURE_SHADOW)
-                             ? vol_shadow_lit(p, frame, shadow_map, features & VOL_FEATURE_SHADOW_REVERSED)
-                             : (VOL_REAL)1;
-    vol_height_segment(tail_from, (VOL_REAL)INFINITY, s_origin, wy, d0, lit, (VOL_REAL)0, depth, hp, hf, fog_ext, fog_in,
-                       fog_sun_depth, fog_amb, fog_sun);
+  if (!height) {
+    coverage[0] = coverage[1] = coverage[2] = -expm1(-depth);
+    return VOL_MAKE4(i_r, i_g, i_b, coverage[0]);
   }
-  if (!(hf & FOG_HF_RGB)) {
-    fog_amb[1] = fog_amb[2] = fog_amb[0];
-    fog_sun[1] = fog_sun[2] = fog_sun[0];
-  }
-  /* P += F·ambient + S·λ·sun; coverage 1 - e^(-(volumes' depth + the fog's β_ext·H)) (grey). */
-  VOL_REAL lobe = (VOL_REAL)0;
-  if (hf & FOG_HF_SUN) {
-    const VOL_V3 l = VOL_P3(frame, VOL_F_HEIGHT_SUN);
-    lobe = fog_sun_lobe(fog_sun_q(dir.x, dir.y, dir.z, l.x, l.y, l.z), hp[FOG_HP_SUN_EXP]);
-  }
-  i_r += hp[FOG_HP_FOG] * fog_amb[0] + ((hf & FOG_HF_SUN) ? hp[FOG_HP_SUN] * lobe * fog_sun[0] : (VOL_REAL)0);
-  i_g += hp[FOG_HP_FOG + 1] * fog_amb[1] + ((hf & FOG_HF_SUN) ? hp[FOG_HP_SUN + 1] * lobe * fog_sun[1] : (VOL_REAL)0);
-  i_b += hp[FOG_HP_FOG + 2] * fog_amb[2] + ((hf & FOG_HF_SUN) ? hp[FOG_HP_SUN + 2] * lobe * fog_sun[2] : (VOL_REAL)0);
-  return VOL_MAKE4(i_r, i_g, i_b, -expm1(-(depth + fog_ext[0])));
+  return vol_height_finish(origin, dir, tail_from, infinite, s_origin, d0, depth, VOL_MAKE3(i_r, i_g, i_b), hp, hf,
+                           frame, shadow_map, features, fog_ext, fog_in, fog_sun_depth, fog_amb, fog_sun, coverage);
 }
 
 /* The target pixel (lx, ly) as the march sees it: its ray, the distance along it to the occluder,
@@ -572,19 +640,21 @@ VOL_FN VOL_V4 vol_over(VOL_V4 target, VOL_V4 c) {
 }
 
 /* The target pixel (lx, ly): its ray, its occluder, the march of the chosen integrator. Returns
- * (P premultiplied RGB, coverage A) and the block's eye depth in *key for the upsampling. */
+ * (P premultiplied RGB, coverage A), the coverage per channel in coverage[0..2] (vol_physical) and
+ * the block's eye depth in *key for the upsampling. */
 VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buffer, VOL_GLOBAL const float* frame,
                               VOL_GLOBAL const float* vols, int count, VOL_NOISE_PARAM, int noise_size,
                               VOL_GLOBAL const float* shadow_map, VOL_UINT frame_index, int integrator, int steps,
                               int features, int height_features, int jitter, int projection, int reversed_z, int kind,
-                              VOL_REAL* key) {
+                              VOL_REAL* key, VOL_REAL* coverage) {
   VOL_V3 origin, dir;
   VOL_REAL t_scene, t_per_eye;
   vol_pixel_view(lx, ly, depth_buffer, frame, projection, reversed_z, kind, &origin, &dir, &t_scene, &t_per_eye, key);
   const float j = vol_jitter((VOL_UINT)lx, (VOL_UINT)ly, frame_index);
   if (integrator != VOL_STYLIZED)
     return vol_physical(origin, dir, t_scene, t_per_eye, jitter ? (VOL_REAL)j : (VOL_REAL)0.5f, vols, count, frame,
-                        noise, noise_size, shadow_map, steps, features, height_features, integrator == VOL_RIEMANN);
+                        noise, noise_size, shadow_map, steps, features, height_features, integrator == VOL_RIEMANN,
+                        coverage);
   /* stylized: each volume drawn over the target in the order given. */
   VOL_V4 target = VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   for (int i = 0; i < count; ++i) {
@@ -595,6 +665,7 @@ VOL_FN VOL_V4 vol_march_pixel(int lx, int ly, VOL_GLOBAL const float* depth_buff
     target = vol_over(target, vol_stylized_volume(origin, dir, t0, t1, t_scene, jitter ? (VOL_REAL)j : (VOL_REAL)0, vol,
                                                   frame, noise, noise_size, shadow_map, steps, features));
   }
+  coverage[0] = coverage[1] = coverage[2] = target.w;
   return target;
 }
 #endif /* VOL_LANE_INSTANCE */

@@ -13,8 +13,10 @@
  *   VOL_NOISE_IMAGE  the noise is a 3D image read with the sampler's linear filter; else a
  *                    buffer of unorm8 texels filtered by volume_noise.h
  *   VOL_LANES        target pixels per work-item: 16 on CPU devices (noise as a buffer), else 1
+ *   FOG_PORTABLE     CPU devices: OpenCL C only, no target builtins (fog_cpu_avx512.h)
  *   VOL_HEIGHT_FEATURES  with VOL_FEATURE_HEIGHT: the marched height fog's FOG_HF_* bits
- *                    (docs/DESIGN.md §6.5); one pixel per work-item (the lanes do not carry it)
+ *                    (docs/DESIGN.md §6.5); with VOL_FEATURE_HEIGHT_RGB the target holds a
+ *                    coverage per channel (volume_composite.h's layout)
  *   VOL_FEATURE_LIGHTS / VOL_FEATURE_SPOT in VOL_FEATURES: local lights, read after the volumes
  *                    (VOL_F_LIGHT_OFFSET); one pixel per work-item (the lanes do not carry them)
  *
@@ -30,7 +32,7 @@
  */
 #pragma OPENCL FP_CONTRACT OFF
 
-#define FOG_EXP2 fog_exp2_poly
+#define FOG_EXP2 FOG_NAME(fog_exp2_poly)
 #include "fog_math.h" /* the one-pixel instance */
 
 #ifndef VOL_LANES
@@ -64,6 +66,18 @@ constant sampler_t vol_noise_sampler = CLK_NORMALIZED_COORDS_TRUE | CLK_ADDRESS_
 #include "volume_noise.h"
 #include "volume_integrate.h"
 
+/* Target pixel i (volume_composite.h's layout): (P, A) and, with a coverage per channel,
+ * (A_r, A_g, A_b, 0), A their largest. */
+static inline void vol_store_target(global float* low, size_t i, float4 r, const float* coverage) {
+#if VOL_FEATURES & VOL_FEATURE_HEIGHT_RGB
+  r.w = fmax(coverage[0], fmax(coverage[1], coverage[2]));
+  vstore4(r, 2 * i, low);
+  vstore4((float4)(coverage[0], coverage[1], coverage[2], 0.0f), 2 * i + 1, low);
+#else
+  vstore4(r, i, low);
+#endif
+}
+
 #if VOL_LANES == 1
 kernel void volume_march(global const float* depth, global const float* frame, global const float* volumes,
                          int count, VOL_NOISE_PARAM, int noise_size, global const float* shadow_map,
@@ -71,18 +85,27 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   const int lx = get_global_id(0), ly = get_global_id(1);
   const int low_width = (int)frame[VOL_F_LOW_WIDTH];
   if (lx >= low_width || ly >= (int)frame[VOL_F_LOW_HEIGHT]) return;
-  float key;
+  float key, coverage[3];
   const float4 r = vol_march_pixel(lx, ly, depth, frame, volumes, count, noise, noise_size, shadow_map, frame_index,
                                    VOL_INTEGRATOR, VOL_STEPS, VOL_FEATURES, VOL_HEIGHT_FEATURES, VOL_JITTER, FOG_PROJECTION,
-                                   VOL_REVERSED_Z, VOL_DEPTH_KIND, &key);
+                                   VOL_REVERSED_Z, VOL_DEPTH_KIND, &key, coverage);
   const size_t i = (size_t)ly * (size_t)low_width + (size_t)lx;
-  vstore4(r, i, low);
+  vol_store_target(low, i, r, coverage);
   low_key[i] = key;
 }
 
 #elif VOL_LANES == 16
 #if VOL_FEATURES & VOL_FEATURE_HEIGHT
-#error "the marched height fog runs one pixel per work-item"
+/* The marched height fog's segments lane-wise: fog_math.h's 16-pixel instance (names _v), with the
+ * deferred pass's AVX-512 hooks for e^x's floor and 2^n (the same bits: fog_cpu_avx512.h). */
+#include "fog_cpu_avx512.h"
+#ifdef FOG_AVX512
+#define FOG_FLOOR fog_floor_avx512
+#define FOG_SCALE2 fog_scale2_avx512
+#endif
+#define FOG_LANES16
+#include "fog_math.h"
+#define VOL_LANE_HEIGHT
 #endif
 #if VOL_FEATURES & VOL_FEATURE_LIGHTS
 #error "local lights run one pixel per work-item"
@@ -188,6 +211,8 @@ static inline __attribute__((overloadable)) float16 vol_shadow_lit(vol_float3x16
 #undef VOL_TEXEL_ROW
 #undef VOL_UINT
 #undef VOL_NOISE_R
+#undef VOL_FOG
+#define VOL_FOG(name) name##_v
 #define VOL_REAL float16
 #define VOL_V3 vol_float3x16
 #define VOL_V4 vol_float4x16
@@ -230,14 +255,14 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   if (lx0 >= low_width || ly >= (int)frame[VOL_F_LOW_HEIGHT]) return;
   /* Per pixel: the ray, the occluder, the jitter. Lanes past the row's end repeat its last pixel
    * and are not stored. */
-  float ox[16], oy[16], oz[16], dx[16], dy[16], dz[16], scene[16], jitter[16], key[16];
+  float ox[16], oy[16], oz[16], dx[16], dy[16], dz[16], scene[16], jitter[16], key[16], t_per_eye[16];
   float4 target[16];
+  float coverage[16][3];
   for (int k = 0; k < 16; ++k) {
     const int lx = min(lx0 + k, low_width - 1);
     float3 o, d;
-    float t_per_eye;
-    vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, VOL_DEPTH_KIND, &o, &d, &scene[k], &t_per_eye,
-                   &key[k]);
+    vol_pixel_view(lx, ly, depth, frame, FOG_PROJECTION, VOL_REVERSED_Z, VOL_DEPTH_KIND, &o, &d, &scene[k],
+                   &t_per_eye[k], &key[k]);
     ox[k] = o.x, oy[k] = o.y, oz[k] = o.z, dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
     const float j = vol_jitter((uint)lx, (uint)ly, frame_index);
     jitter[k] = VOL_JITTER ? j : VOL_INTEGRATOR == VOL_STYLIZED ? 0.0f : 0.5f;
@@ -283,6 +308,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
         target[k] = vol_over(target[k], vol_stylized_shade((float3)(dx[k], dy[k], dz[k]), acc[k], sh[k], m[k], vol,
                                                            frame, VOL_FEATURES));
   }
+  for (int k = 0; k < 16; ++k) coverage[k][0] = coverage[k][1] = coverage[k][2] = target[k].w;
 #else
   /* physical: each lane walks its ray's pieces and segments as vol_physical does; an iteration
    * takes every live lane's next segment, so all lanes sample at once while their pieces differ.
@@ -291,14 +317,29 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   float a[16], b[16], covered[16], n[16], j[16], cos_theta[16];
   uint hit[16], mask[16];
   int live[16], pieces[16];
+#if VOL_FEATURES & VOL_FEATURE_HEIGHT
+  /* The marched height fog walks as volume `count` (vol_physical); its segments go lane-wise, an
+   * infinite ray's tail and the fog's light per lane (vol_height_finish). */
+  const int walked = count + 1;
+  const uint fog_bit = 1u << count;
+  float hp[FOG_HP_COUNT], s_origin[16], d0[16], tail_from[16];
+  int infinite[16];
+  for (int i = 0; i < FOG_HP_COUNT; ++i) hp[i] = frame[VOL_F_HEIGHT_P + i];
+#else
+  const int walked = count;
+#endif
   for (int k = 0; k < 16; ++k) {
     const float3 o = (float3)(ox[k], oy[k], oz[k]), d = (float3)(dx[k], dy[k], dz[k]);
     hit[k] = vol_physical_hits(o, d, scene[k], volumes, count, t_in[k], t_out[k], &a[k]);
+#if VOL_FEATURES & VOL_FEATURE_HEIGHT
+    vol_height_ray(o, d, scene[k], t_per_eye[k], frame, hp, VOL_HEIGHT_FEATURES, count, t_in[k], t_out[k], &hit[k],
+                   &a[k], &s_origin[k], &d0[k], &tail_from[k], &infinite[k]);
+#endif
     cos_theta[k] = dot(d, VOL_PU3(frame, VOL_F_LIGHT_DIR));
-    covered[k] = hit[k] != 0u ? vol_covered(t_in[k], t_out[k], hit[k], count, a[k]) : 0.0f;
+    covered[k] = hit[k] != 0u ? vol_covered(t_in[k], t_out[k], hit[k], walked, a[k]) : 0.0f;
     pieces[k] = 0;
     j[k] = 0.0f;
-    const int first = hit[k] != 0u && vol_lane_next_piece(t_in[k], t_out[k], hit[k], count, covered[k], &a[k], &b[k],
+    const int first = hit[k] != 0u && vol_lane_next_piece(t_in[k], t_out[k], hit[k], walked, covered[k], &a[k], &b[k],
                                                           &mask[k], &n[k], &pieces[k]);
     live[k] = first ? -1 : 0;
   }
@@ -306,6 +347,14 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   vol_physical_phases(vload16(0, cos_theta), volumes, count, phase);
   float16 i_r = 0.0f, i_g = 0.0f, i_b = 0.0f, optical = 0.0f;
   float16 s1 = 0.0f; /* each lane's last segment end: the next segment's start within a piece */
+#if VOL_FEATURES & VOL_FEATURE_HEIGHT
+  /* The fog's sums per channel (channel 0 alone where the coefficients are grey), as vol_physical's. */
+  float16 fog_ext[3] = {0.0f, 0.0f, 0.0f}, fog_in[3] = {0.0f, 0.0f, 0.0f}, fog_sun_depth[3] = {0.0f, 0.0f, 0.0f};
+  float16 fog_amb[3] = {0.0f, 0.0f, 0.0f}, fog_sun[3] = {0.0f, 0.0f, 0.0f};
+  const float16 s_origin16 = vload16(0, s_origin), d0_16 = vload16(0, d0);
+  const int fog_channels = (VOL_HEIGHT_FEATURES & FOG_HF_RGB) ? 3 : 1;
+  const int channels = (VOL_FEATURES & VOL_FEATURE_HEIGHT_RGB) ? 3 : 1;
+#endif
   for (;;) {
     const int16 alive = vload16(0, live);
     if (!VOL_ANY16(alive)) break;
@@ -324,6 +373,42 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     const float16 sigma_t = vol_physical_sample(p, t, phase, lit, volumes_here, volumes, count, frame, noise,
                                                 noise_size, VOL_FEATURES, &source, 0);
     const int16 adds = sigma_t > 0.0f;
+#if VOL_FEATURES & VOL_FEATURE_HEIGHT
+    /* vol_physical's fog segment, on the lanes whose segment has the fog; extinctions add. */
+    const int16 fogged = (volumes_here & fog_bit) != 0u;
+    const float16 ext_before[3] = {fog_ext[0], fog_ext[1], fog_ext[2]};
+    if (VOL_ANY16(fogged)) {
+      float16 e[3], in[3], sd[3], am[3], su[3];
+      for (int c = 0; c < fog_channels; ++c)
+        e[c] = fog_ext[c], in[c] = fog_in[c], sd[c] = fog_sun_depth[c], am[c] = fog_amb[c], su[c] = fog_sun[c];
+      /* Without volumes in any lane's segment (the fog alone, mostly) the fog's share of the
+       * scattering is 1 at compile time: no division for it. */
+      if (VOL_ANY16(adds))
+        vol_height_segment(s0, s1, s_origin16, dir.y, d0_16, lit, adds ? sigma_t * seg : 0.0f, optical, hp,
+                           VOL_HEIGHT_FEATURES, e, in, sd, am, su);
+      else
+        vol_height_segment(s0, s1, s_origin16, dir.y, d0_16, lit, (float16)0.0f, optical, hp, VOL_HEIGHT_FEATURES, e,
+                           in, sd, am, su);
+      for (int c = 0; c < fog_channels; ++c) {
+        fog_ext[c] = fogged ? e[c] : fog_ext[c];
+        fog_in[c] = fogged ? in[c] : fog_in[c];
+        fog_sun_depth[c] = fogged ? sd[c] : fog_sun_depth[c];
+        fog_amb[c] = fogged ? am[c] : fog_amb[c];
+        fog_sun[c] = fogged ? su[c] : fog_sun[c];
+      }
+    }
+    if (VOL_ANY16(adds)) {
+      float16 scatter[3];
+      for (int c = 0; c < channels; ++c)
+        scatter[c] = vol_segment_weight(fogged ? sigma_t + (fog_ext[c] - ext_before[c]) / seg : sigma_t, seg,
+                                        optical + ext_before[c], VOL_INTEGRATOR == VOL_RIEMANN);
+      if (channels == 1) scatter[1] = scatter[2] = scatter[0];
+      i_r = adds ? i_r + source.x * scatter[0] : i_r;
+      i_g = adds ? i_g + source.y * scatter[1] : i_g;
+      i_b = adds ? i_b + source.z * scatter[2] : i_b;
+      optical = adds ? optical + sigma_t * seg : optical;
+    }
+#else
     if (VOL_ANY16(adds)) {
       const float16 scatter = vol_segment_weight(sigma_t, seg, optical, VOL_INTEGRATOR == VOL_RIEMANN);
       i_r = adds ? i_r + source.x * scatter : i_r;
@@ -331,6 +416,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
       i_b = adds ? i_b + source.z * scatter : i_b;
       optical = adds ? optical + sigma_t * seg : optical;
     }
+#endif
     vstore16(pj + 1.0f, 0, j);
     const int16 piece_ends = alive && pj + 1.0f == pn;
     if (!VOL_ANY16(piece_ends)) continue;
@@ -340,7 +426,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
       if (ends[k]) {
         a[k] = b[k];
         j[k] = 0.0f;
-        live[k] = vol_lane_next_piece(t_in[k], t_out[k], hit[k], count, covered[k], &a[k], &b[k], &mask[k], &n[k],
+        live[k] = vol_lane_next_piece(t_in[k], t_out[k], hit[k], walked, covered[k], &a[k], &b[k], &mask[k], &n[k],
                                       &pieces[k]) ? -1 : 0;
       }
   }
@@ -348,13 +434,42 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   vstore16(i_r, 0, r);
   vstore16(i_g, 0, g);
   vstore16(i_b, 0, bl);
+#if VOL_FEATURES & VOL_FEATURE_HEIGHT
+  vstore16(optical, 0, cov);
+  float sums[5][3][16]; /* the fog's ext, in, sun depth, ambient, sun sums per channel and lane */
+  for (int c = 0; c < fog_channels; ++c) {
+    vstore16(fog_ext[c], 0, sums[0][c]);
+    vstore16(fog_in[c], 0, sums[1][c]);
+    vstore16(fog_sun_depth[c], 0, sums[2][c]);
+    vstore16(fog_amb[c], 0, sums[3][c]);
+    vstore16(fog_sun[c], 0, sums[4][c]);
+  }
+  for (int k = 0; k < 16; ++k) {
+    if (hit[k] == 0u && !infinite[k]) { /* no fog, no volume: vol_physical's early return */
+      target[k] = (float4)(0.0f);
+      coverage[k][0] = coverage[k][1] = coverage[k][2] = 0.0f;
+      continue;
+    }
+    float e[3], in[3], sd[3], am[3], su[3];
+    for (int c = 0; c < fog_channels; ++c)
+      e[c] = sums[0][c][k], in[c] = sums[1][c][k], sd[c] = sums[2][c][k], am[c] = sums[3][c][k], su[c] = sums[4][c][k];
+    target[k] = vol_height_finish((float3)(ox[k], oy[k], oz[k]), (float3)(dx[k], dy[k], dz[k]), tail_from[k],
+                                  infinite[k], s_origin[k], d0[k], cov[k], (float3)(r[k], g[k], bl[k]), hp,
+                                  VOL_HEIGHT_FEATURES, frame, shadow_map, VOL_FEATURES, e, in, sd, am, su,
+                                  coverage[k]);
+  }
+#else
   vstore16(-expm1(-optical), 0, cov);
-  for (int k = 0; k < 16; ++k) target[k] = (float4)(r[k], g[k], bl[k], cov[k]);
+  for (int k = 0; k < 16; ++k) {
+    target[k] = (float4)(r[k], g[k], bl[k], cov[k]);
+    coverage[k][0] = coverage[k][1] = coverage[k][2] = cov[k];
+  }
+#endif
 #endif
   const int lanes = min(16, low_width - lx0);
   for (int k = 0; k < lanes; ++k) {
     const size_t at = (size_t)ly * (size_t)low_width + (size_t)(lx0 + k);
-    vstore4(target[k], at, low);
+    vol_store_target(low, at, target[k], coverage[k]);
     low_key[at] = key[k];
   }
 }

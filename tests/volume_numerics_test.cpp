@@ -26,9 +26,10 @@ std::array<T, 2> unit_chord(double sigma_t, int steps, bool riemann = false) {
   vol[VOL_V_DENSITY] = float(sigma_t);
   for (int k = 0; k < 3; ++k) vol[VOL_V_ALBEDO + k] = vol[VOL_V_AMBIENT + k] = 1.0f;
   const glm::vec<3, T> origin(0), dir(0, 0, 1);
+  T coverage[3];
   const glm::vec<4, T> r = volume_formulas::vol_physical<T>(origin, dir, T(INFINITY), T(1), T(0.5), vol.data(), 1,
                                                             frame.data(), nullptr, 0, nullptr, steps, 0, 0,
-                                                            int(riemann));
+                                                            int(riemann), coverage);
   return {r.x, r.w};  // I (one channel), A = 1 - T
 }
 

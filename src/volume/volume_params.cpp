@@ -172,10 +172,6 @@ void validate(const VolumeSettings& s) {
     if (f.height.max_opacity != 1.0f)
       throw Error("the marched height fog's maximum opacity must be 1 (got " + str(f.height.max_opacity) +
                   "): a clamp of the whole ray cannot be applied per segment");
-    const glm::vec3 e = detail::height_extinction(f);
-    if (e.x != e.y || e.x != e.z)
-      throw Error("the marched height fog's extinction must be the same in all three channels (got " + str(e.x) +
-                  ", " + str(e.y) + ", " + str(e.z) + ")");
   }
 }
 
@@ -384,6 +380,9 @@ void pack_height_fog(PackedVolumeFrame& out, const FogSettings& fog, const Camer
   VolumeVariant& v = out.variant;
   v.features |= VOL_FEATURE_HEIGHT;
   v.height_features = fv.height_features | (fog.fog_skybox ? FOG_HF_SKYBOX : 0);
+  // Only an extinction that differs per channel needs the target's coverage per channel.
+  const glm::vec3 e = height_extinction(fog);
+  if ((v.height_features & FOG_HF_RGB) && (e.x != e.y || e.x != e.z)) v.features |= VOL_FEATURE_HEIGHT_RGB;
   // The volumes' buffer is bound even when no volume is visible: one unread entry.
   if (out.volumes.empty()) out.volumes.assign(VOL_V_STRIDE, 0.0f);
   float* k = out.frame.data();
@@ -580,11 +579,18 @@ int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
   // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
   // work-items, which the march's loops prevent; the lanes instance has no image sampling.
   const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
-  // The marched height fog and the local lights run one pixel per work-item: the lanes instance
-  // does not carry them.
-  if (v.features & (VOL_FEATURE_HEIGHT | VOL_FEATURE_LIGHTS)) return 1;
+  // The local lights run one pixel per work-item: the lanes instance does not carry them.
+  if (v.features & VOL_FEATURE_LIGHTS) return 1;
   return pixels_per_work_item(device) == 16 && buffer ? 16 : 1;
 }
+
+int volume_composite_lanes(const VolumeVariant& v, const DeviceTraits& device) {
+  // A target with a coverage per channel is composited one pixel per work-item (the CPU lanes'
+  // quads hold one coverage per pixel).
+  return target_floats(v) == 4 ? pixels_per_work_item(device) : 1;
+}
+
+int target_floats(const VolumeVariant& v) { return (v.features & VOL_FEATURE_HEIGHT_RGB) ? 8 : 4; }
 
 std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& device) {
   std::string o = cl_std_option(device);
@@ -600,6 +606,7 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
   if (v.noise_sampling == NoiseSampling::image && (v.features & VOL_FEATURE_NOISE)) o += " -D VOL_NOISE_IMAGE";
   if (v.noise_sampling == NoiseSampling::buffer && (v.features & VOL_FEATURE_NOISE) && !device.cpu)
     o += " -D VOL_TEXEL_WORD_LOADS";  // kernels/volume_noise.h: GPUs only
+  if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }
 
@@ -607,15 +614,16 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
 // ray, its occluder, key, jitter and result (13); the staging of the noise and shadow-map helpers
 // inlined into it (10); the stylized march's per-volume entries (7), or the physical walk's state
 // (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES); with the marched height
-// fog its FOG_HP_* constants and its per-channel sums (20); with local lights their spans along the
-// ray and the volumes' extinctions of a segment (2 x VOL_MAX_LIGHTS + VOL_MAX_VOLUMES). Twice that for what the
+// fog its FOG_HP_* constants and its per-channel sums, their copies and the lanes' staging of
+// them (60); with local lights their spans along the ray and the volumes' extinctions of a segment
+// (2 x VOL_MAX_LIGHTS + VOL_MAX_VOLUMES). Twice that for what the
 // compiler keeps besides (spilled vectors, copies): PoCL 3.1's work-group functions hold 0.9-1.15x
 // the arrays per work-item (their stack frames: 6.4-6.8 KB physical, 1.7-2.2 KB stylized at 16
 // lanes).
 std::size_t volume_march_private_bytes(const VolumeVariant& v, const DeviceTraits& device) {
   const std::size_t per_lane =
       13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES) +
-      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 20 : 0) +  // the marched fog's constants and sums
+      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 60 : 0) +  // the marched fog's constants and sums
       ((v.features & VOL_FEATURE_LIGHTS) ? 2 * VOL_MAX_LIGHTS + VOL_MAX_VOLUMES : 0);  // light spans, extinctions
   return 2 * 4 * per_lane * std::size_t(volume_march_lanes(v, device));
 }
@@ -635,15 +643,17 @@ std::string volume_composite_options(const VolumeVariant& v, const DeviceTraits&
   if (v.reversed_z) o += " -D REVERSED_Z";
   if (v.depth_kind != DepthKind::raw) o += " -D VOL_DEPTH_KIND=" + std::to_string(int(v.depth_kind));
   if (v.storage == ColorFormat::rgba16f) o += " -D FOG_COLOR_HALF";
-  o += " -D VOL_LANES=" + std::to_string(pixels_per_work_item(device));
-  o += streaming_store_option(device, v.storage);  // as the deferred pass's (variant.h)
+  const int lanes = volume_composite_lanes(v, device);
+  o += " -D VOL_LANES=" + std::to_string(lanes);
+  if (target_floats(v) == 8) o += " -D VOL_TARGET_RGB";
+  if (lanes > 1) o += streaming_store_option(device, v.storage);  // as the deferred pass's (variant.h)
   if (device.cpu && !device.codegen.target_intrinsics) o += " -D FOG_PORTABLE";
   return o;
 }
 
 std::array<std::size_t, 2> volume_composite_global(const VolumeVariant& v, const DeviceTraits& device, int width,
                                                    int height) {
-  const int lanes = pixels_per_work_item(device), s = v.scale;
+  const int lanes = volume_composite_lanes(v, device), s = v.scale;
   const std::size_t x = std::size_t((width + lanes - 1) / lanes);
   if (lanes == 1 || s == 1) return {x, std::size_t(height)};
   // Work-item m takes rows s m - s / 2 .. s m + s / 2 - 1 (vol_rows_of): the last one the row H - 1.

@@ -69,6 +69,12 @@ int integrator_code(VolumeIntegrator integrator);
 // instance applies, else 1. The global size's x is ceil(low_width / lanes).
 int volume_march_lanes(const VolumeVariant& variant, const DeviceTraits& device);
 std::string volume_march_options(const VolumeVariant& variant, const DeviceTraits& device);
+// Frame pixels per work-item of the composite (its VOL_LANES): pixels_per_work_item, but 1 for a
+// target with a coverage per channel.
+int volume_composite_lanes(const VolumeVariant& variant, const DeviceTraits& device);
+// Floats per target pixel (kernels/volume_composite.h's layout): 4, or 8 with a coverage per
+// channel (the marched height fog's extinction differs per channel).
+int target_floats(const VolumeVariant& variant);
 std::string volume_composite_options(const VolumeVariant& variant, const DeviceTraits& device);
 // Upper bounds of one work-item's private memory [bytes] in the march and the composite of a
 // variant, from the kernels' private arrays: what the launches' work-group shape is bounded by

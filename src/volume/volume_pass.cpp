@@ -34,11 +34,12 @@ const Source kComposite{"volume_composite.cl", volume_composite_cl, "volume_comp
 void fit_buffer(const cl::Context& ctx, cl::Buffer& b, std::size_t bytes, cl_mem_flags flags) {
   if (b() == nullptr || b.getInfo<CL_MEM_SIZE>() < bytes) b = cl::Buffer(ctx, flags, bytes);
 }
-// The march's low-resolution output for `f`: RGBA in `low`, its depth key in `low_key`.
+// The march's low-resolution output for `f`: (P, A) and any coverage per channel in `low`, its
+// depth key in `low_key`.
 void fit_march_output(const cl::Context& ctx, const detail::PackedVolumeFrame& f, cl::Buffer& low,
                       cl::Buffer& low_key) {
   const std::size_t low_pixels = std::size_t(f.low_width) * std::size_t(f.low_height);
-  fit_buffer(ctx, low, low_pixels * 4 * sizeof(float), CL_MEM_READ_WRITE);
+  fit_buffer(ctx, low, low_pixels * std::size_t(detail::target_floats(f.variant)) * sizeof(float), CL_MEM_READ_WRITE);
   fit_buffer(ctx, low_key, low_pixels * sizeof(float), CL_MEM_READ_WRITE);
 }
 }  // namespace

@@ -49,17 +49,24 @@ VolumeResult<T> volumes_in(const ConstColorView& in, const ConstDepthView& depth
   const int integrator = detail::integrator_code(v.integrator);
   r.low_width = f.low_width;
   r.low_height = f.low_height;
-  r.low.resize(4 * std::size_t(f.low_width) * f.low_height);
+  const int stride = detail::target_floats(v);
+  r.low_floats = stride;
+  r.low.resize(std::size_t(stride) * f.low_width * f.low_height);
   r.low_key.resize(std::size_t(f.low_width) * f.low_height);
   for (int ly = 0; ly < f.low_height; ++ly)
     for (int lx = 0; lx < f.low_width; ++lx) {
       const std::size_t i = std::size_t(ly) * f.low_width + lx;
-      T key;
-      const glm::vec<4, T> p = vol_march_pixel<T>(
+      T key, coverage[3];
+      glm::vec<4, T> p = vol_march_pixel<T>(
           lx, ly, depth.data(), f.frame.data(), f.volumes.data(), int(f.visible.size()), noise, settings.noise_size,
           shadow_map, scene.frame_index, integrator, v.steps, v.features, v.height_features, v.jitter, projection,
-          reversed, kind, &key);
-      for (int k = 0; k < 4; ++k) r.low[4 * i + k] = p[k];
+          reversed, kind, &key, coverage);
+      if (stride == 8) {  // kernels/volume_composite.h's layout, as the kernel stores it
+        p.w = std::fmax(coverage[0], std::fmax(coverage[1], coverage[2]));
+        for (int k = 0; k < 3; ++k) r.low[8 * i + 4 + k] = coverage[k];
+        r.low[8 * i + 7] = T(0);
+      }
+      for (int k = 0; k < 4; ++k) r.low[std::size_t(stride) * i + k] = p[k];
       r.low_key[i] = key;
     }
   const float* k = f.frame.data();
@@ -68,11 +75,16 @@ VolumeResult<T> volumes_in(const ConstColorView& in, const ConstDepthView& depth
       const std::size_t i = std::size_t(y) * w + x;
       const T rho = v.depth_aware && v.scale > 1 ? vol_inverse_eye_depth(T(depth.data()[i]), k, projection, reversed, kind)
                                                  : T(0);
-      const glm::vec<4, T> fog =
-          vol_upsample(x, y, rho, r.low.data(), r.low_key.data(), f.low_width, f.low_height, v.scale, v.depth_aware);
+      std::size_t at[4];
+      T weight[4];
+      const int normalise = vol_upsample_weights(x, y, rho, r.low_key.data(), f.low_width, f.low_height, v.scale,
+                                                 v.depth_aware, at, weight);
+      const glm::vec<4, T> fog = vol_upsample_taps(r.low.data(), stride, 0, at, weight, normalise, v.scale);
+      const glm::vec<4, T> cover =
+          stride == 8 ? vol_upsample_taps(r.low.data(), stride, 4, at, weight, normalise, v.scale) : glm::vec<4, T>(fog.w);
       r.coverage[i] = fog.w;
       if (fog.w == T(0)) continue;
-      for (int c = 0; c < 3; ++c) r.rgba[4 * i + c] = vol_composite(r.rgba[4 * i + c], fog[c], fog.w);
+      for (int c = 0; c < 3; ++c) r.rgba[4 * i + c] = vol_composite(r.rgba[4 * i + c], fog[c], cover[c]);
     }
   return r;
 }

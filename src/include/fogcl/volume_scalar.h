@@ -17,7 +17,10 @@ struct VolumeResult {
   std::vector<T> rgba;                // 4 * width * height: the composited frame, in T
   std::vector<T> coverage;            // width * height: the upsampled coverage A (0: untouched)
   int low_width = 0, low_height = 0;  // the target: ceil(W / s) x ceil(H / s)
-  std::vector<T> low;                 // 4 per target pixel: premultiplied RGB, coverage A
+  int low_floats = 4;                 // per target pixel: 4, or 8 with a coverage per channel
+  std::vector<T> low;                 // low_floats per target pixel: premultiplied RGB, coverage A, and
+                                      // where the marched height fog's extinction differs per channel
+                                      // the coverage per channel (A_r, A_g, A_b, 0), A their largest
   std::vector<T> low_key;             // per target pixel: the eye depth it marched to (+inf sky)
   std::size_t visible = 0;            // volumes left after culling
 };
