@@ -70,3 +70,26 @@ std::vector<FogVolume> demo_fog_volumes(VolumeIntegrator integrator) {
 }
 
 }  // namespace fogcl
+
+namespace fogcl {
+
+FogSettings demo_shaft_fog() {
+  // A ground haze a few units deep (thins by e per 1/0.3 units of height), thick enough that the
+  // spheres' shadows cut dark shafts out of the sun's glow. Values chosen by looking at the PNGs.
+  FogSettings f;
+  f.mode = FogMode::height;
+  f.color = glm::vec3(0.12f, 0.15f, 0.2f);
+  f.density = 0.06f;
+  f.height.falloff = 0.2f;
+  f.height.cutoff = 100.0f;
+  f.height.base_height = 0.0f;
+  f.fog_skybox = true;
+  SunLobe sun;
+  sun.direction = demo_low_sun().direction;
+  sun.color = glm::vec3(1.8f, 1.45f, 0.95f);
+  sun.exponent = 16.0f;
+  f.height.sun = sun;
+  return f;
+}
+
+}  // namespace fogcl
