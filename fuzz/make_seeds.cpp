@@ -23,7 +23,8 @@ void write_json_seeds(const std::string& dir) {
   put("minimal.json", R"({"volumes": [{"center": [0, 1, 0], "radius": 2}]})");
   put("homogeneous.json", R"({"volumes": [{"center": [0, 1, 0], "radius": 2, "medium": "homogeneous", "albedo": [0.5, 0.5, 0.5]}]})");
   put("empty.json", R"({"volumes": []})");
-  std::printf("wrote 5 seed files to %s\n", dir.c_str());
+  put("lights.json", R"({"volumes": [{"center": [0, 1, 0], "radius": 2}], "lights": [{"type": "point", "position": [0, 1, 0], "intensity": 5, "range": 4}, {"type": "spot", "position": [1, 3, 0], "direction": [0, -1, 0], "inner_angle": 10, "outer_angle": 25}]})");
+  std::printf("wrote 6 seed files to %s\n", dir.c_str());
 }
 
 }  // namespace

@@ -432,6 +432,33 @@ TEST_F(CliVolumes, BadVolumesJsonIsOneLineNamingVolumeKeyAndRule) {
        "{\"volumes\": [\n  {\"center\": [0, 1, 0], \"radius\": 2,}\n]}",
        {"malformed JSON", "line 2, column"}},
       {"not JSON at all", "volumes = 3", {"malformed JSON", "line 1, column 1"}},
+      {"light without a type", R"({"volumes": [], "lights": [{"position": [0, 1, 0]}]})", {"light 0", "'type' is missing"}},
+      {"light of an unknown type",
+       R"({"volumes": [], "lights": [{"type": "area", "position": [0, 1, 0]}]})",
+       {"light 0", "'type'", "\"point\" or \"spot\"", "\"area\""}},
+      {"light without a position", R"({"volumes": [], "lights": [{"type": "point"}]})", {"light 0", "'position' is missing"}},
+      {"misspelt light key",
+       R"({"volumes": [], "lights": [{"type": "point", "position": [0, 1, 0], "intensty": 2}]})",
+       {"light 0", "unknown key 'intensty'", "did you mean 'intensity'"}},
+      {"cone on a point light",
+       R"({"volumes": [], "lights": [{"type": "point", "position": [0, 1, 0], "outer_angle": 30}]})",
+       {"light 0", "'outer_angle'", "spot lights only"}},
+      {"light's wrong type",
+       R"({"volumes": [], "lights": [{"type": "point", "position": [0, 1, 0]}, {"type": "point", "position": [0, 1, 0], "range": "far"}]})",
+       {"light 1", "'range'", "must be a number"}},
+      {"light range",
+       R"({"volumes": [], "lights": [{"type": "point", "position": [0, 1, 0], "range": 0}]})",
+       {"light 0", "range", "(0, 1e15]", "got 0"}},
+      {"spot cone order",
+       R"({"volumes": [], "lights": [{"type": "spot", "position": [0, 1, 0], "inner_angle": 50, "outer_angle": 40}]})",
+       {"light 0", "inner_angle", "[0, outer_angle]", "50"}},
+      {"light too bright for its radius",
+       R"({"volumes": [], "lights": [{"type": "point", "position": [0, 1, 0], "intensity": 1e30, "radius": 1e-3}]})",
+       {"light 0", "intensity", "<= 1e30"}},
+      {"lights not an array", R"({"volumes": [], "lights": {"type": "point"}})", {"'lights' must be an array"}},
+      {"duplicate light key",
+       R"({"volumes": [], "lights": [{"type": "point", "position": [0, 1, 0], "position": [0, 2, 0]}]})",
+       {"light 0", "duplicate key 'position'"}},
   };
   for (const auto& c : cases) {
     const std::string path = in("bad-volumes.json");
@@ -445,7 +472,7 @@ TEST_F(CliVolumes, BadVolumesJsonIsOneLineNamingVolumeKeyAndRule) {
 }
 
 // The library reads VOLUMES.json as the command line does (fogcl/volumes_json.h): random volumes
-// written by volumes_to_json read back as the same floats, and for files made bad by random byte
+// and lights written by volumes_to_json read back as the same floats, and for files made bad by random byte
 // changes the CLI's line is "fogcl: error: " and the library's message, word for word.
 TEST_F(CliVolumes, TheLibraryReadsVolumesJsonAsTheCommandLineDoes) {
   std::mt19937 rng(2024);
@@ -462,9 +489,34 @@ TEST_F(CliVolumes, TheLibraryReadsVolumesJsonAsTheCommandLineDoes) {
       v.tiling = 0.01f + unit3();
       if (u(rng) < 0.5f) v.albedo = unit3();
     }
+    std::vector<LocalLight> lights(std::size_t(i % 4));
+    for (LocalLight& l : lights) {
+      l.kind = u(rng) < 0.5f ? LightKind::point : LightKind::spot;
+      l.position = 100.0f * unit3() - glm::vec3(50.0f);
+      l.color = unit3();
+      l.intensity = 1000.0f * u(rng);
+      l.range = 0.5f + 100.0f * u(rng);
+      l.radius = l.range * (0.001f + 0.5f * u(rng));
+      l.direction = unit3() - glm::vec3(0.5f, 1.0f, 0.5f);
+      l.outer_angle = 1.0f + 89.0f * u(rng);
+      l.inner_angle = l.outer_angle * u(rng);
+      if (l.kind == LightKind::point) l.direction = LocalLight{}.direction;  // a point light writes no cone
+      if (l.kind == LightKind::point) l.inner_angle = LocalLight{}.inner_angle, l.outer_angle = LocalLight{}.outer_angle;
+    }
     const std::string path = in("random.json");
-    write_text(path, volumes_to_json(volumes));
-    const std::vector<FogVolume> back = read_volumes_json(path);
+    write_text(path, volumes_to_json(volumes, lights));
+    const VolumesFile file = read_volumes_file(path);
+    const std::vector<FogVolume>& back = file.volumes;
+    ASSERT_EQ(file.lights.size(), lights.size());
+    for (std::size_t k = 0; k < lights.size(); ++k) {
+      const LocalLight &a = file.lights[k], &b = lights[k];
+      EXPECT_TRUE(a.kind == b.kind && a.position == b.position && a.color == b.color && a.intensity == b.intensity &&
+                  a.range == b.range && a.radius == b.radius && a.direction == b.direction &&
+                  a.inner_angle == b.inner_angle && a.outer_angle == b.outer_angle)
+          << i << " light " << k;
+    }
+    if (lights.empty()) EXPECT_EQ(read_volumes_json(path).size(), volumes.size());
+    else EXPECT_THROW(read_volumes_json(path), Error) << "the volumes-only reader would drop the lights";
     ASSERT_EQ(back.size(), volumes.size());
     for (std::size_t k = 0; k < back.size(); ++k) {
       EXPECT_EQ(std::memcmp(&back[k].center, &volumes[k].center, sizeof(glm::vec3)), 0) << i;
@@ -472,7 +524,7 @@ TEST_F(CliVolumes, TheLibraryReadsVolumesJsonAsTheCommandLineDoes) {
       EXPECT_EQ(back[k].density, volumes[k].density) << i;
       EXPECT_EQ(back[k].albedo.has_value(), volumes[k].albedo.has_value()) << i;
     }
-    EXPECT_EQ(volumes_to_json(back), volumes_to_json(volumes)) << i;
+    EXPECT_EQ(volumes_to_json(file), volumes_to_json(volumes, lights)) << i;
     ++round_trips;
   }
   int compared = 0;

@@ -295,8 +295,16 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
       throw Error("--max-error must be a number >= 0 (got " + str(o.max_error) + ")");
   }
 
-  if (!o.volumes_path.empty()) s.volumes_ = read_volumes_json(o.volumes_path);
+  if (!o.volumes_path.empty()) {
+    VolumesFile file = read_volumes_file(o.volumes_path);
+    s.volumes_ = std::move(file.volumes);
+    s.lights_ = std::move(file.lights);
+  }
   for (FogVolume& v : s.volumes_) v = volume_to_fogcl(axes, v);
+  for (LocalLight& l : s.lights_) {  // a point and a direction; the rest are lengths, angles, colors
+    l.position = to_fogcl * l.position;
+    l.direction = to_fogcl * l.direction;
+  }
   s.runtime_ = runtime;
   if (runtime != nullptr) s.pass_ = std::make_unique<VolumePass>(*runtime);
   return stage;
@@ -305,6 +313,7 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
 VolumeScene VolumeStage::scene_for(int sequence_frame) const {
   VolumeScene scene;
   scene.volumes = volumes_;
+  scene.lights = lights_;
   if (options_.pose_per_frame && !frame_pose_)
     throw Error("--volumes: no camera pose for this frame (set_frame_pose was not called)");
   scene.pose = options_.pose_per_frame ? *frame_pose_ : pose_;

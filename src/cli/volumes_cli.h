@@ -56,7 +56,7 @@ void add_volume_options(CLI::App& apply, VolumeCliOptions& o);
 // After parsing: records which volume flags were given (their defaults depend on it).
 void note_given_volume_flags(const CLI::App& apply, VolumeCliOptions& o);
 
-// VOLUMES.json is read by the library (fogcl/volumes_json.h: read_volumes_json, volumes_to_json).
+// VOLUMES.json is read by the library (fogcl/volumes_json.h: read_volumes_file, volumes_to_json).
 
 
 // "m00,m01,...,m33": 16 numbers, row-major (the first four are the first row) -> GLM's
@@ -100,6 +100,7 @@ class VolumeStage {
  private:
   VolumeCliOptions options_;
   std::vector<FogVolume> volumes_;
+  std::vector<LocalLight> lights_;
   CameraPose pose_;
   std::optional<CameraPose> frame_pose_;  // options_.pose_per_frame: the current frame's
   std::string pose_from_;

@@ -232,17 +232,78 @@ FogVolume parse_volume(const json& j, const KeyReader& r) {
   return v;
 }
 
+// Every LocalLight field by its snake_case name, but the kind ("type").
+using LightMember = std::variant<float LocalLight::*, glm::vec3 LocalLight::*>;
+const std::map<std::string, LightMember>& light_fields() {
+  static const std::map<std::string, LightMember> fields{
+      {"position", &LocalLight::position}, {"color", &LocalLight::color},
+      {"intensity", &LocalLight::intensity}, {"range", &LocalLight::range},
+      {"radius", &LocalLight::radius},       {"direction", &LocalLight::direction},
+      {"inner_angle", &LocalLight::inner_angle}, {"outer_angle", &LocalLight::outer_angle},
+  };
+  return fields;
+}
+// The keys of a spot light's cone, refused on a point light (they would be silently unused).
+bool spot_only(const std::string& key) { return key == "direction" || key == "inner_angle" || key == "outer_angle"; }
+
+LocalLight parse_light(const json& j, const KeyReader& r) {
+  if (!j.is_object())
+    throw Error(r.where + "must be an object {\"type\": \"point\", \"position\": [x, y, z], ...} (got " + shown(j) +
+                ")");
+  if (!j.contains("type")) throw Error(r.where + "'type' is missing (every light needs \"type\": \"point\" or \"spot\")");
+  if (!j.contains("position"))
+    throw Error(r.where + "'position' is missing (every light needs \"position\": [x, y, z])");
+  LocalLight l;
+  const json& type = j["type"];
+  if (type == "point")
+    l.kind = LightKind::point;
+  else if (type == "spot")
+    l.kind = LightKind::spot;
+  else
+    r.fail("type", "must be \"point\" or \"spot\"", shown(type));
+  for (const auto& item : j.items()) {
+    const std::string key = item.key();
+    const json& value = item.value();
+    if (key == "type") continue;
+    const auto field = light_fields().find(key);
+    if (field == light_fields().end()) {
+      std::string best;
+      std::size_t best_d = 4;
+      for (const auto& f : light_fields()) {
+        const std::size_t d = edit_distance(key, f.first);
+        if (d < best_d) best = f.first, best_d = d;
+      }
+      throw Error(r.where + "unknown key '" + key_text(key) + "' (" +
+                  (best.empty() ? "" : "did you mean '" + best + "'? ") +
+                  "the keys are \"type\" and LocalLight's fields in snake_case: docs/cli.md#volumesjson)");
+    }
+    if (l.kind == LightKind::point && spot_only(key))
+      r.fail(key, "is for spot lights only (\"type\": \"spot\"; a point light has no cone)", shown(value));
+    std::visit(
+        [&](auto member) {
+          using T = std::remove_reference_t<decltype(l.*member)>;
+          if constexpr (std::is_same_v<T, float>) l.*member = r.real(key, value);
+          if constexpr (std::is_same_v<T, glm::vec3>) l.*member = r.vec3(key, value);
+        },
+        field->second);
+  }
+  return l;
+}
+
 // The path of what the parser was reading when it failed, from the callback's key events.
 struct ParseContext {
   std::string top_key;                      // last key of the top-level object
-  std::string volume_key;                   // last key of the current volume object
-  int volume = -1;                          // index of the current volume object
+  std::string item_key;                     // last key of the current volume or light object
+  int item = -1;                            // index of the current volume or light object
   std::vector<std::set<std::string>> keys;  // keys seen in each open object (duplicates)
   std::string duplicate;                    // "volume 1: duplicate key 'radius'"
 
+  // "volume" or "light": what the objects of the current top-level array are.
+  std::string noun() const { return top_key == "lights" ? "light" : "volume"; }
+  bool in_items() const { return (top_key == "volumes" || top_key == "lights") && item >= 0; }
   std::string where() const {
-    if (top_key == "volumes" && volume >= 0)
-      return "volume " + std::to_string(volume) + (volume_key.empty() ? "" : ": '" + key_text(volume_key) + "'");
+    if (in_items())
+      return noun() + " " + std::to_string(item) + (item_key.empty() ? "" : ": '" + key_text(item_key) + "'");
     return top_key.empty() ? "top level" : "top level: '" + key_text(top_key) + "'";
   }
 };
@@ -282,9 +343,18 @@ void check_json_depth(const std::string& text, const std::string& name) {
   }
 }
 
+// The volumes of a file that has no lights: the volumes-only readers never drop a light unsaid.
+std::vector<FogVolume> volumes_alone(VolumesFile file, const std::string& name) {
+  if (!file.lights.empty())
+    throw Error(name + ": has " + std::to_string(file.lights.size()) +
+                " lights, which a reader of the volumes alone would drop: read it with read_volumes_file / "
+                "parse_volumes_file (fogcl/volumes_json.h)");
+  return std::move(file.volumes);
+}
+
 }  // namespace
 
-std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name) {
+VolumesFile parse_volumes_file(const std::string& text, const std::string& name) {
   check_json_depth(text, name);
   ParseContext ctx;
   // Depths as nlohmann counts them: the top object 0, its keys 1, volume objects 2, their keys 3.
@@ -292,18 +362,18 @@ std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::st
     switch (event) {
       case json::parse_event_t::object_start:
         ctx.keys.emplace_back();
-        if (depth == 2 && ctx.top_key == "volumes") ++ctx.volume, ctx.volume_key.clear();
+        if (depth == 2 && (ctx.top_key == "volumes" || ctx.top_key == "lights")) ++ctx.item, ctx.item_key.clear();
         break;
       case json::parse_event_t::object_end:
         if (!ctx.keys.empty()) ctx.keys.pop_back();
         break;
       case json::parse_event_t::key: {
         const std::string key = parsed.get<std::string>();
-        if (depth == 1) ctx.top_key = key;
-        if (depth == 3) ctx.volume_key = key;
+        if (depth == 1 && key != ctx.top_key) ctx.top_key = key, ctx.item = -1;
+        if (depth == 3) ctx.item_key = key;
         // nlohmann keeps the last of repeated keys; a repeat is almost always a mistake.
         if (!ctx.keys.empty() && !ctx.keys.back().insert(key).second && ctx.duplicate.empty())
-          ctx.duplicate = (depth == 3 ? "volume " + std::to_string(ctx.volume) + ": " : std::string()) +
+          ctx.duplicate = (depth == 3 && ctx.in_items() ? ctx.noun() + " " + std::to_string(ctx.item) + ": " : std::string()) +
                           "duplicate key '" + key_text(key) + "' (each key may appear once)";
         break;
       }
@@ -332,25 +402,42 @@ std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::st
   if (!doc.is_object())
     throw Error(name + ": the top level must be an object {\"volumes\": [...]} (got " + shown(doc) + ")");
   for (const auto& [key, value] : doc.items())
-    if (key != "volumes")
-      throw Error(name + ": top level: unknown key '" + key_text(key) + "' (the only key is \"volumes\")");
+    if (key != "volumes" && key != "lights")
+      throw Error(name + ": top level: unknown key '" + key_text(key) + "' (the keys are \"volumes\" and \"lights\")");
   if (!doc.contains("volumes")) throw Error(name + ": top level: 'volumes' is missing (expected {\"volumes\": [...]})");
   const json& list = doc["volumes"];
   if (!list.is_array())
     throw Error(name + ": top level: 'volumes' must be an array of volume objects (got " + shown(list) + ")");
-  std::vector<FogVolume> volumes;
+  VolumesFile file;
   for (std::size_t i = 0; i < list.size(); ++i) {
-    volumes.push_back(parse_volume(list[i], KeyReader{name + ": volume " + std::to_string(i) + ": "}));
+    file.volumes.push_back(parse_volume(list[i], KeyReader{name + ": volume " + std::to_string(i) + ": "}));
     try {
-      validate(volumes.back(), i);  // "volume I: KEY RULE (got V)"
+      validate(file.volumes.back(), i);  // "volume I: KEY RULE (got V)"
     } catch (const Error& e) {
       throw Error(name + ": " + e.what());
     }
   }
-  return volumes;
+  if (doc.contains("lights")) {
+    const json& lights = doc["lights"];
+    if (!lights.is_array())
+      throw Error(name + ": top level: 'lights' must be an array of light objects (got " + shown(lights) + ")");
+    for (std::size_t i = 0; i < lights.size(); ++i) {
+      file.lights.push_back(parse_light(lights[i], KeyReader{name + ": light " + std::to_string(i) + ": "}));
+      try {
+        validate(file.lights.back(), i);  // "light I: KEY RULE (got V)"
+      } catch (const Error& e) {
+        throw Error(name + ": " + e.what());
+      }
+    }
+  }
+  return file;
 }
 
-std::vector<FogVolume> read_volumes_json(const std::string& path) {
+std::vector<FogVolume> parse_volumes_json(const std::string& text, const std::string& name) {
+  return volumes_alone(parse_volumes_file(text, name), name);
+}
+
+VolumesFile read_volumes_file(const std::string& path) {
   // Opened without blocking (a FIFO would wait for a writer) and checked before a byte is read:
   // /dev/zero or a huge file must not grow the text until memory runs out.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
@@ -393,8 +480,10 @@ std::vector<FogVolume> read_volumes_json(const std::string& path) {
     got += std::size_t(n);
   }
   text.resize(got);
-  return parse_volumes_json(text, path);
+  return parse_volumes_file(text, path);
 }
+
+std::vector<FogVolume> read_volumes_json(const std::string& path) { return volumes_alone(read_volumes_file(path), path); }
 
 namespace {
 // The shortest decimal that reads back as f ("0.45", not the double 0.44999998807907104).
@@ -405,7 +494,12 @@ double shortest(float f) {
 }
 }  // namespace
 
-std::string volumes_to_json(const std::vector<FogVolume>& volumes) {
+std::string volumes_to_json(const std::vector<FogVolume>& volumes) { return volumes_to_json(volumes, {}); }
+
+std::string volumes_to_json(const VolumesFile& file) { return volumes_to_json(file.volumes, file.lights); }
+
+std::string volumes_to_json(const std::vector<FogVolume>& volumes, const std::vector<LocalLight>& lights) {
+  const auto v3 = [](const glm::vec3& a) { return json::array({shortest(a.x), shortest(a.y), shortest(a.z)}); };
   json list = json::array();
   for (const FogVolume& v : volumes) {
     json j = json::object();
@@ -427,7 +521,26 @@ std::string volumes_to_json(const std::vector<FogVolume>& volumes) {
           member);
     list.push_back(j);
   }
-  return json{{"volumes", list}}.dump(2) + "\n";
+  json doc{{"volumes", list}};
+  if (!lights.empty()) {
+    json out = json::array();
+    for (const LocalLight& l : lights) {
+      json j{{"type", to_string(l.kind)}};
+      for (const auto& [key, member] : light_fields()) {
+        if (l.kind == LightKind::point && spot_only(key)) continue;
+        std::visit(
+            [&, key = key](auto m) {
+              using T = std::remove_cv_t<std::remove_reference_t<decltype(l.*m)>>;
+              if constexpr (std::is_same_v<T, float>) j[key] = shortest(l.*m);
+              if constexpr (std::is_same_v<T, glm::vec3>) j[key] = v3(l.*m);
+            },
+            member);
+      }
+      out.push_back(j);
+    }
+    doc["lights"] = out;
+  }
+  return doc.dump(2) + "\n";
 }
 
 }  // namespace fogcl

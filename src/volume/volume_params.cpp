@@ -54,6 +54,8 @@ struct VolumeChecker {
 };
 constexpr float kInf = INFINITY;
 constexpr float kBig = 3.4e38f;
+constexpr float kMaxLightRange = 1e15f;  // range^2 and the window's sums stay far inside float
+constexpr double kMaxLightPeak = 1e30;   // intensity * color / radius^2: sums over lights stay finite
 }  // namespace
 
 void validate(const FogVolume& v, std::size_t index) {
@@ -103,6 +105,28 @@ void validate(const MainLight& l) {
   for (int k = 0; k < 3; ++k)
     if (!(std::isfinite(l.color[k]) && l.color[k] >= 0.0f))
       throw Error("light color must be RGB, finite and >= 0 (got " + str(l.color) + ")");
+}
+
+void validate(const LocalLight& l, std::size_t index) {
+  const VolumeChecker c{"light " + std::to_string(index) + ": "};
+  if (l.kind != LightKind::point && l.kind != LightKind::spot)
+    c.fail("kind", "must be point or spot", std::to_string(int(l.kind)));
+  c.vec("position", l.position, -kBig, kBig, "must be finite");
+  c.vec("color", l.color, 0.0f, kBig, "must be RGB, finite and >= 0");
+  c.real("intensity", l.intensity, 0.0f, false, kBig, false, "must be finite and >= 0");
+  c.real("range", l.range, 0.0f, true, kMaxLightRange, false, "must be finite and in (0, 1e15]");
+  c.real("radius", l.radius, 0.0f, true, l.range, false, "must be finite and in (0, range]");
+  const float brightest = std::max({l.color.x, l.color.y, l.color.z});
+  const double peak = double(l.intensity) * double(brightest) / (double(l.radius) * double(l.radius));
+  if (!(peak <= kMaxLightPeak))
+    c.fail("intensity",
+           "* max(color) / radius^2 must be <= 1e30 (the light's peak at its source must stay within float range)",
+           str(peak));
+  if (l.kind != LightKind::spot) return;
+  if (!finite(l.direction) || glm::length(l.direction) == 0.0f)
+    c.fail("direction", "must be a finite non-zero vector", str(l.direction));
+  c.real("outer_angle", l.outer_angle, 0.0f, true, 90.0f, false, "must be in (0, 90] degrees");
+  c.real("inner_angle", l.inner_angle, 0.0f, false, l.outer_angle, false, "must be in [0, outer_angle] degrees");
 }
 
 void validate(const ShadowMapParams& s) {
@@ -156,6 +180,7 @@ void validate(const VolumeScene& s) {
   for (std::size_t i = 0; i < s.volumes.size(); ++i) validate(s.volumes[i], i);
   validate(s.pose);
   validate(s.light);
+  for (std::size_t i = 0; i < s.lights.size(); ++i) validate(s.lights[i], i);
   if (!std::isfinite(s.time)) throw Error("time must be finite (got " + str(s.time) + ")");
 }
 
@@ -167,6 +192,7 @@ const char* to_string(VolumeIntegrator i) {
   }
   return "unknown";
 }
+const char* to_string(LightKind k) { return k == LightKind::spot ? "spot" : "point"; }
 const char* to_string(VolumeUpsampling u) { return u == VolumeUpsampling::depth_aware ? "depth-aware" : "bilinear"; }
 const char* resolution_name(int divisor) { return divisor == 1 ? "full" : divisor == 2 ? "half" : "quarter"; }
 const char* to_string(NoiseSampling s) {
@@ -386,6 +412,9 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
       throw Error("shadow map size must be at least 1x1 (got " + std::to_string(shadow_width) + "x" +
                   std::to_string(shadow_height) + ")");
   }
+  if (!scene.lights.empty() && settings.integrator == VolumeIntegrator::stylized)
+    throw Error("local lights need the physical integrator (got stylized, with " + std::to_string(scene.lights.size()) +
+                " lights): the seed's accumulator has no per-sample light to add them to");
   PackedVolumeFrame out;
   out.visible = visible_volumes(scene, camera, max_eye_depth);  // validates scene and camera
   if (out.visible.size() > VOL_MAX_VOLUMES)

@@ -3,6 +3,7 @@
 // color. When the deferred fog runs too, the volumes are composited first.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -55,6 +56,43 @@ struct FogVolume {
 };
 
 // CameraPose (the camera's position and orientation) is in fogcl/camera.h.
+
+// A local light's shape (LocalLight::kind).
+enum class LightKind {
+  point,  // shines in every direction
+  spot,   // shines into a cone around LocalLight::direction
+};
+
+// A point or spot light that glows in the fog (docs/volumetric.md#local-lights): the physical
+// integrator scatters it toward the eye in the fog volumes and in the marched height fog, with
+// each medium's phase function and the same transmittance as the main light. Unshadowed.
+// A medium point at distance d from the light scatters toward the eye the radiance
+//   intensity * color * phase * sigma_s * window(d) * cone / (d^2 + radius^2),
+// window(d) = (1 - d^2 / range^2)^2 for d < range, else 0 (1 at the light, 0 with zero slope at
+// the range: the light adds exactly 0 beyond it). A volume's sigma_s = albedo * its extinction.
+struct LocalLight {
+  LightKind kind = LightKind::point;
+  glm::vec3 position{0.0f};             // [world], finite
+  glm::vec3 color{1.0f};                // linear RGB, finite, >= 0
+  // Radiant intensity of color 1 [radiance x world^2, the main light's irradiance x world^2]:
+  // finite, >= 0. intensity * max(color) / radius^2 must be <= 1e30 (the peak stays in float).
+  float intensity = 1.0f;
+  float range = 10.0f;                  // [world], finite, in (0, 1e15]: nothing beyond it
+  // Source radius [world], finite, in (0, range]: the inverse square is 1 / (d^2 + radius^2), so
+  // a sample at the light (or a ray through it) sees a finite peak intensity / radius^2.
+  float radius = 0.05f;
+  // Spot only. The cone's axis, from the light outward: finite, non-zero (normalised by the pass).
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};
+  // Spot only: half-angles from the axis [degrees], 0 <= inner_angle <= outer_angle, outer_angle
+  // in (0, 90]. Full intensity within inner_angle, 0 beyond outer_angle; between them the factor
+  // saturate((cos a - cos outer) / max(cos inner - cos outer, 1e-4))^2 of the angle a to the axis.
+  float inner_angle = 30.0f;
+  float outer_angle = 45.0f;
+};
+
+// At most this many local lights reach the volumes and the marched fog in one frame (lights
+// whose range meets no visible medium, or that are black, do not count).
+inline constexpr std::size_t kMaxLocalLights = 32;
 
 // The main (directional) light.
 struct MainLight {
@@ -138,6 +176,8 @@ struct VolumeScene {
   std::vector<FogVolume> volumes;
   CameraPose pose;
   MainLight light;
+  // Point and spot lights: the physical integrator only (the stylized one refuses them).
+  std::vector<LocalLight> lights;
   float time = 0.0f;                     // [s], finite: noise scrolls by speed * time
   std::uint32_t frame_index = 0;         // seeds the per-ray jitter
 };
@@ -146,12 +186,15 @@ struct VolumeScene {
 void validate(const FogVolume& volume, std::size_t index = 0);
 void validate(const CameraPose& pose);
 void validate(const MainLight& light);
+// "light 2: range must be finite and in (0, 1e15] (got -1)".
+void validate(const LocalLight& light, std::size_t index = 0);
 void validate(const ShadowMapParams& shadow);
 void validate(const VolumeSettings& settings);
 void validate(const VolumeScene& scene);
 
 const char* to_string(VolumeIntegrator integrator);
 const char* to_string(VolumeUpsampling upsampling);
+const char* to_string(LightKind kind);  // "point", "spot"
 const char* to_string(NoiseSampling sampling);
 // VolumeSettings::resolution_divisor's name: 1 "full", 2 "half", 4 "quarter".
 const char* resolution_name(int divisor);
