@@ -367,6 +367,40 @@ TEST(VolumeErrorBudgetCli, MaxErrorPicksTheVariantAndExplicitFlagsConflict) {
   EXPECT_FALSE(fs::exists(dir + "/tiny.exr"));
 }
 
+// fogcl apply --mode height --height-volumetric --max-error, without --volumes: the budget picks the
+// march's variant from the marched fog's own measurement (here the cache the API wrote).
+TEST(VolumeErrorBudgetCli, MaxErrorPicksTheMarchedHeightFogsVariant) {
+  FOGCL_REQUIRE_DEVICE();
+  const std::string dir = fresh_dir("volume-budget-height-cli");
+  const DemoFrame frame = render_demo_scene(48, 27);
+  write_exr_rgba(dir + "/scene.exr", frame.color);
+  write_exr_depth(dir + "/scene-depth.exr", frame.depth);
+  VolumeSettings base;
+  base.integrator = VolumeIntegrator::physical;
+  base.height_fog = demo_shaft_fog();
+  const ColorFormat storage = read_exr_color(dir + "/scene.exr").format();
+  const VolumeQualityChoice measured =
+      choose_volume_quality(*runtime(), base, storage, 1e9, small_budget(dir + "/xdg/fogcl"));
+  const DemoView view;
+  const glm::vec3 fwd = view.target - view.eye;
+  char pose[256];
+  std::snprintf(pose, sizeof pose, " --eye %.9g,%.9g,%.9g --forward %.9g,%.9g,%.9g --up 0,1,0", view.eye.x, view.eye.y,
+                view.eye.z, fwd.x, fwd.y, fwd.z);
+  const std::string cmd = "apply --color " + dir + "/scene.exr --depth " + dir +
+                          "/scene-depth.exr --near 0.3 --far 1000 --fov 60 --mode height --density 0.05 "
+                          "--height-falloff 0.3 --height-volumetric --verbose --max-error 1e9" +
+                          pose + " --device " + cli_device() + " --out " + dir + "/out.exr";
+  const CliRun r = run_cli(cmd, "XDG_CACHE_HOME='" + dir + "/xdg'");
+  std::printf("%s", r.output.c_str());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("measurement read from the cache"), std::string::npos) << r.output;
+  const std::string chosen = volume_quality_name(measured.chosen.steps, measured.chosen.divisor,
+                                                 measured.chosen.upsampling, measured.chosen.noise);
+  EXPECT_NE(r.output.find("volumes: " + chosen + " is the fastest variant"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("with the marched height fog"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir + "/out.exr"));
+}
+
 // fogcl report's volumetric flags: bad values and misplaced flags are one line, exit 1, before
 // any measurement.
 TEST(VolumeReportCli, BadFlagsAreOneLineErrors) {
