@@ -69,6 +69,46 @@ TEST_F(Cli, DemoVolumeRowsAreReproducedByApply) {
   EXPECT_EQ(differing, 0u);
 }
 
+// The light-shaft rows: the shadow map only takes the sun's light away (never adds), and it cuts
+// shafts: along some image row, shadowed runs of fog alternate with lit ones.
+TEST_F(Cli, DemoShaftRowHasShafts) {
+  const std::string kind = runtime() ? "opencl" : "scalar";
+  for (const char* row : {"height-shafts ", "height-shafts-lit "})
+    EXPECT_NE(demo_output_.find(row), std::string::npos) << row << " in " << demo_output_;
+  const ColorImage shafts = read_exr_color(in("height-shafts-" + kind + ".exr"));
+  const ColorImage lit = read_exr_color(in("height-shafts-lit-" + kind + ".exr"));
+  const ColorImage scene = read_exr_color(in("scene-low-sun.exr"));
+  ASSERT_EQ(shafts.size_bytes(), lit.size_bytes());
+  const auto luminance = [](const glm::vec4& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; };
+  double brighter = 0.0, darkest = 0.0, fog_gain = 0.0;
+  std::size_t shadowed = 0, most_runs = 0;
+  for (int y = 0; y < shafts.height(); ++y) {
+    std::size_t runs = 0;
+    bool in_run = false;
+    for (int x = 0; x < shafts.width(); ++x) {
+      const double d = luminance(lit.pixel(x, y)) - luminance(shafts.pixel(x, y));
+      for (int c = 0; c < 3; ++c)
+        brighter = std::max(brighter, double(shafts.pixel(x, y)[c]) - double(lit.pixel(x, y)[c]));
+      darkest = std::max(darkest, d);
+      fog_gain = std::max(fog_gain, luminance(lit.pixel(x, y)) - luminance(scene.pixel(x, y)));
+      const bool dark = d > 0.02;  // a shadowed stretch of the ray: the sun's glow is missing
+      shadowed += dark ? 1 : 0;
+      if (dark && !in_run) ++runs;
+      in_run = dark;
+    }
+    most_runs = std::max(most_runs, runs);
+  }
+  const double pct = 100.0 * double(shadowed) / double(shafts.pixel_count());
+  std::printf("[ measured ] height-shafts vs its lit row: up to %.3g darker (lit fog adds up to %.3g), %.3g brighter; "
+              "%.1f%% of pixels shadowed; up to %zu separate shadowed runs in one image row\n",
+              darkest, fog_gain, brighter, pct, most_runs);
+  EXPECT_LE(brighter, 1e-5) << "a shadow never adds light";
+  EXPECT_GT(darkest, 0.1) << "the spheres' shadows are visible in the fog";
+  EXPECT_GT(pct, 2.0);
+  EXPECT_LT(pct, 90.0) << "shafts, not a shadow over everything";
+  EXPECT_GE(most_runs, 2u) << "lit and shadowed columns alternate";
+}
+
 TEST_F(Cli, ApplyMatchesTheDoublePath) {
   const std::string common = "--color " + in("scene.exr") + " --depth " + in("scene-depth.exr") +
                              " --near 0.3 --far 1000 --fov 60 --mode exp2 --density 0.03 --distance"
