@@ -105,6 +105,8 @@
 #define VOL_F_SHADOW_BIAS 59
 #define VOL_F_INV_NEAR 60    /* 1 / near, 1 / far (0 with an infinite far plane), rounded once */
 #define VOL_F_INV_FAR 61
+#define VOL_F_LIGHT_COUNT 62 /* local lights (VOL_FEATURE_LIGHTS), at most VOL_MAX_LIGHTS */
+#define VOL_F_LIGHT_OFFSET 63 /* where their VOL_L_* entries start in the volumes' array [floats] */
 /* The marched height fog (VOL_FEATURE_HEIGHT, docs/DESIGN.md §6.5): */
 #define VOL_F_HEIGHT_P 64    /* fog_math.h's FOG_HP_* constants (FOG_HP_COUNT = 19) */
 #define VOL_F_HEIGHT_BASE 83 /* base height b [world y] */
@@ -141,6 +143,17 @@
 #define VOL_V_ANISOTROPY 41
 #define VOL_V_AMBIENT 42     /* (3) */
 #define VOL_V_STRIDE 48
+
+/* One local light (docs/volumetric.md#local-lights), after the volumes in their array. */
+#define VOL_L_POSITION 0     /* [world] (3) */
+#define VOL_L_RADIANCE 3     /* intensity * color (3) */
+#define VOL_L_RANGE 6        /* [world] */
+#define VOL_L_INV_RANGE2 7   /* 1 / range^2: the window (1 - d^2 / range^2)^2 */
+#define VOL_L_RADIUS2 8      /* source radius^2 [world^2]: 1 / (d^2 + radius^2) */
+#define VOL_L_AXIS 9         /* spot: unit axis, from the light outward (3) */
+#define VOL_L_SPOT_SCALE 12  /* spot: cone = saturate(cos * scale + offset)^2; point: scale 0, offset 1 */
+#define VOL_L_SPOT_OFFSET 13
+#define VOL_L_STRIDE 16
 
 /* The seed's constants, named where the march uses them. */
 #define VOL_JITTER_SPAN 0.1f       /* stylized start offset: -jitter * step * 0.1 */

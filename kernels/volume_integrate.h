@@ -13,6 +13,14 @@
 #define VOL_FEATURE_HEIGHT 64        /* physical: the height fog marched (docs/DESIGN.md §6.5); its
                                       * FOG_HF_* bits are VOL_HEIGHT_FEATURES */
 #define VOL_MAX_VOLUMES 32           /* visible volumes per frame (the host checks) */
+#define VOL_FEATURE_LIGHTS 1024      /* physical: local lights (VOL_F_LIGHT_COUNT of them), one pixel per work-item */
+#define VOL_FEATURE_SPOT 2048        /* ... some of them spot lights: the cone's factor */
+#define VOL_MAX_LIGHTS 32            /* local lights per frame that reach a medium (the host checks) */
+/* A light's stretch of a segment is cut into pieces that each subtend at most this angle [rad] at
+ * the light (docs/volumetric.md#local-lights): 1 where the light is far, up to 32 where the
+ * segment passes it. */
+#define VOL_LIGHT_ANGLE_STEP 0.09817477042468103 /* pi / 32 */
+#define VOL_LIGHT_MAX_PIECES 32
 
 /* Henyey-Greenstein phase function, normalised over the sphere (1 / 4 pi when g = 0); cos_theta
  * between the ray and the direction toward the light (forward scattering peaks looking at it). */
@@ -144,15 +152,18 @@ VOL_FN VOL_V4 vol_stylized_volume(VOL_V3 origin, VOL_V3 dir, VOL_REAL front, VOL
 /* The extinction [1/world] and the albedo-weighted light of the volumes of `mask` at p, t:
  * sigma_t = density * field * fades per volume, summed; *source = sum of sigma_t * albedo * L with
  * L = light * phase[i] * shadow + ambient, phase[i] volume i's phase function along the ray (one
- * value per ray: vol_physical_phases). A volume adds where its bit is set (a per-lane select). */
+ * value per ray: vol_physical_phases). A volume adds where its bit is set (a per-lane select).
+ * With VOL_FEATURE_LIGHTS, each[i] is volume i's extinction (0 outside `mask`): the local
+ * lights' phase differs per volume and per light. */
 VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, const VOL_REAL* phase, VOL_REAL lit, VOL_UINT mask,
                                     VOL_GLOBAL const float* vols, int count, VOL_GLOBAL const float* frame,
-                                    VOL_NOISE_PARAM, int noise_size, int features, VOL_V3* source) {
+                                    VOL_NOISE_PARAM, int noise_size, int features, VOL_V3* source, VOL_REAL* each) {
   const VOL_U3 light = VOL_PU3(frame, VOL_F_LIGHT_COLOR);
   const VOL_U time = VOL_PU(frame, VOL_F_TIME);
   VOL_REAL sigma_t = (VOL_REAL)0, s_r = (VOL_REAL)0, s_g = (VOL_REAL)0, s_b = (VOL_REAL)0;
   for (int i = 0; i < count; ++i) {
     const VOL_INT in = ((mask >> i) & 1u) != 0u;
+    if ((features & VOL_FEATURE_LIGHTS) && !VOL_ANY(in)) each[i] = (VOL_REAL)0;
     if (!VOL_ANY(in)) continue;
     VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
     VOL_REAL sigma = (VOL_REAL)VOL_PU(vol, VOL_V_DENSITY);
@@ -165,6 +176,7 @@ VOL_FN VOL_REAL vol_physical_sample(VOL_V3 p, VOL_REAL t, const VOL_REAL* phase,
     s_g = in ? s_g + albedo.y * (light.y * phase_lit + ambient.y) * sigma : s_g;
     s_b = in ? s_b + albedo.z * (light.z * phase_lit + ambient.z) * sigma : s_b;
     sigma_t = in ? sigma_t + sigma : sigma_t;
+    if (features & VOL_FEATURE_LIGHTS) each[i] = in ? sigma : (VOL_REAL)0;
   }
   *source = VOL_MAKE3(s_r, s_g, s_b);
   return sigma_t;
@@ -240,6 +252,91 @@ VOL_FN VOL_REAL vol_covered(const VOL_REAL* t_in, const VOL_REAL* t_out, VOL_UIN
     a = b;
   }
   return covered;
+}
+
+/* Local lights (docs/volumetric.md#local-lights). The ray's stretch inside each light's range
+ * sphere, clipped to [0, t_scene], once per ray: a segment outside it skips the light. */
+VOL_FN void vol_light_spans(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_GLOBAL const float* lights, int n,
+                            VOL_REAL* l_in, VOL_REAL* l_out) {
+  for (int k = 0; k < n; ++k) {
+    VOL_GLOBAL const float* light = lights + k * VOL_L_STRIDE;
+    VOL_REAL t0, t1;
+    const int hit = vol_sphere_hit(origin, dir, VOL_P3(light, VOL_L_POSITION), VOL_P(light, VOL_L_RANGE), &t0, &t1);
+    l_in[k] = hit ? t0 : (VOL_REAL)INFINITY;
+    l_out[k] = hit ? fmin(t1, t_scene) : (VOL_REAL)0;
+  }
+}
+
+/* sigma_s * phase toward the eye of the media at a point lit from cos_theta (between the ray and
+ * the direction toward the light): each volume of `mask` with its albedo and Henyey-Greenstein g
+ * (each[i]: its extinction), plus fog_scatter (the marched height fog's scattering coefficient
+ * per channel) with the isotropic phase. */
+VOL_FN VOL_V3 vol_light_scatter(VOL_REAL cos_theta, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols,
+                                int count, VOL_V3 fog_scatter) {
+  VOL_V3 s = fog_scatter * (VOL_REAL)(1.0 / (4.0 * 3.14159265358979323846));
+  for (int i = 0; i < count; ++i) {
+    if (!((mask >> i) & 1u)) continue;
+    VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
+    s = s + VOL_P3(vol, VOL_V_ALBEDO) * (each[i] * vol_phase_hg(cos_theta, VOL_PU(vol, VOL_V_ANISOTROPY)));
+  }
+  return s;
+}
+
+/* The local lights' in-scattered radiance over the segment [s0, s1] of a ray, extinction sigma_t
+ * in it (constant), optical depth `depth` before it. For each light whose span meets the segment,
+ * its part [a, b] is cut into pieces of at most VOL_LIGHT_ANGLE_STEP as seen from the light; on a
+ * piece [ua, ub] (u = t - t0, t0 the ray's closest approach, c = h^2 + radius^2) the inverse
+ * square is integrated exactly, int du / (u^2 + c) = (angle subtended) / sqrt(c), and the
+ * transmittance by its mean over the piece, T(ua) (1 - e^(-sigma_t (ub - ua))) / (sigma_t (ub - ua));
+ * the window, the cone and the phase are taken at the piece's angular midpoint. A sample at the
+ * light or a ray through it is finite: c >= radius^2 > 0. */
+VOL_FN VOL_V3 vol_lights_segment(VOL_V3 origin, VOL_V3 dir, VOL_REAL s0, VOL_REAL s1, VOL_REAL sigma_t, VOL_REAL depth,
+                                 const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols, int count,
+                                 VOL_V3 fog_scatter, VOL_GLOBAL const float* lights, int n_lights,
+                                 const VOL_REAL* l_in, const VOL_REAL* l_out, int features) {
+  VOL_V3 sum = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  for (int k = 0; k < n_lights; ++k) {
+    const VOL_REAL a = fmax(s0, l_in[k]), b = fmin(s1, l_out[k]);
+    if (!(b > a)) continue; /* the segment is outside the light's range */
+    VOL_GLOBAL const float* light = lights + k * VOL_L_STRIDE;
+    const VOL_V3 pos = VOL_P3(light, VOL_L_POSITION), rel = pos - origin;
+    const VOL_REAL t0 = dot(rel, dir);
+    const VOL_V3 perp = rel - dir * t0;
+    const VOL_REAL sc = sqrt(dot(perp, perp) + VOL_P(light, VOL_L_RADIUS2));
+    const VOL_REAL xa = (a - t0) / sc, xb = (b - t0) / sc;
+    /* atan(xb) - atan(xa) without the cancellation of two angles near +-pi/2 (a far segment) */
+    const VOL_REAL span = xa * xb > (VOL_REAL)-1 ? atan((b - a) / sc / ((VOL_REAL)1 + xa * xb)) : atan(xb) - atan(xa);
+    const int n = min(VOL_LIGHT_MAX_PIECES, max(1, (int)ceil(span / (VOL_REAL)VOL_LIGHT_ANGLE_STEP)));
+    const VOL_REAL piece = span / (VOL_REAL)n, phi_a = atan(xa);
+    const VOL_REAL mass = piece / sc; /* int du / (u^2 + c) over one piece */
+    VOL_REAL x1 = xa;
+    VOL_V3 light_sum = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+    for (int j = 0; j < n; ++j) {
+      const VOL_REAL x0 = x1;
+      x1 = j + 1 == n ? xb : fmin(fmax(tan(phi_a + piece * (VOL_REAL)(j + 1)), x0), xb);
+      const VOL_REAL xm = fmin(fmax(tan(phi_a + piece * ((VOL_REAL)j + (VOL_REAL)0.5f)), x0), x1);
+      const VOL_REAL ta = t0 + x0 * sc, len = (x1 - x0) * sc, tm = t0 + xm * sc;
+      const VOL_REAL thick = sigma_t * len;
+      const VOL_REAL mean = thick > (VOL_REAL)0 ? -expm1(-thick) / thick : (VOL_REAL)1;
+      const VOL_REAL transmittance = exp(-(depth + sigma_t * fmax(ta - s0, (VOL_REAL)0))) * mean;
+      const VOL_V3 to_light = pos - (origin + dir * tm);
+      const VOL_REAL d2 = dot(to_light, to_light);
+      const VOL_REAL w = (VOL_REAL)1 - d2 * VOL_P(light, VOL_L_INV_RANGE2);
+      if (!(w > (VOL_REAL)0)) continue;
+      const VOL_REAL d = sqrt(d2);
+      const VOL_REAL cos_theta = d > (VOL_REAL)0 ? dot(dir, to_light) / d : (VOL_REAL)0;
+      VOL_REAL cone = (VOL_REAL)1;
+      if (features & VOL_FEATURE_SPOT) {
+        const VOL_REAL cos_axis = d > (VOL_REAL)0 ? -dot(to_light, VOL_P3(light, VOL_L_AXIS)) / d : (VOL_REAL)1;
+        const VOL_REAL f = vol_saturate(cos_axis * VOL_P(light, VOL_L_SPOT_SCALE) + VOL_P(light, VOL_L_SPOT_OFFSET));
+        cone = f * f;
+      }
+      light_sum = light_sum + vol_light_scatter(cos_theta, each, mask, vols, count, fog_scatter) *
+                                  (w * w * cone * transmittance);
+    }
+    sum = sum + VOL_P3(light, VOL_L_RADIANCE) * mass * light_sum;
+  }
+  return sum;
 }
 
 /* The marched height fog's stretch of a ray (docs/DESIGN.md §6.5): §6.2's [s0, s1] in distance
@@ -344,6 +441,12 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
     }
   }
   if (hit == 0u && !infinite) return VOL_MAKE4((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
+  /* Local lights: their spans along the ray once; each[] the volumes' extinctions of a segment. */
+  const int n_lights = (features & VOL_FEATURE_LIGHTS) ? (int)VOL_P(frame, VOL_F_LIGHT_COUNT) : 0;
+  VOL_GLOBAL const float* lights = vols + ((features & VOL_FEATURE_LIGHTS) ? (int)VOL_P(frame, VOL_F_LIGHT_OFFSET) : 0);
+  VOL_REAL l_in[VOL_MAX_LIGHTS], l_out[VOL_MAX_LIGHTS], each[VOL_MAX_VOLUMES];
+  if (n_lights > 0) vol_light_spans(origin, dir, t_scene, lights, n_lights, l_in, l_out);
+  const VOL_V3 no_fog = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   VOL_REAL phase[VOL_MAX_VOLUMES];
   vol_physical_phases(dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR)), vols, count, phase);
   const VOL_REAL covered = hit != 0u ? vol_covered(t_in, t_out, hit, walked, start) : (VOL_REAL)0;
@@ -366,13 +469,27 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
                                  : (VOL_REAL)1;
         VOL_V3 source;
         const VOL_REAL sigma_t = vol_physical_sample(p, t, phase, lit, mask, vols, count, frame, noise,
-                                                     noise_size, features, &source);
+                                                     noise_size, features, &source, each);
         if (height && (mask & fog_bit)) {
           /* Extinctions add: the volumes' light shares the segment with the fog's (§6.5). */
           const VOL_REAL other = sigma_t > (VOL_REAL)0 ? sigma_t * seg : (VOL_REAL)0;
           const VOL_REAL ext_before = fog_ext[0];
+          const VOL_REAL in_before[3] = {fog_in[0], fog_in[1], fog_in[2]};
           vol_height_segment(s0, s1, s_origin, wy, d0, lit, other, depth, hp, hf, fog_ext, fog_in, fog_sun_depth,
                              fog_amb, fog_sun);
+          if (n_lights > 0) {
+            /* The fog's scattering coefficient: its in-scattering depth over the segment per unit
+             * length (one channel without FOG_HF_RGB); extinctions add as for the main light. */
+            const int rgb = (hf & FOG_HF_RGB) != 0;
+            const VOL_V3 fog_scatter = VOL_MAKE3(fog_in[0] - in_before[0], rgb ? fog_in[1] - in_before[1] : fog_in[0] - in_before[0],
+                                                 rgb ? fog_in[2] - in_before[2] : fog_in[0] - in_before[0]) / seg;
+            const VOL_REAL sigma_all = (sigma_t > (VOL_REAL)0 ? sigma_t : (VOL_REAL)0) + (fog_ext[0] - ext_before) / seg;
+            const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sigma_all, depth + ext_before, each, mask, vols,
+                                                count, fog_scatter, lights, n_lights, l_in, l_out, features);
+            i_r += l.x;
+            i_g += l.y;
+            i_b += l.z;
+          }
           if (!(sigma_t > (VOL_REAL)0)) continue;
           const VOL_REAL scatter =
               vol_segment_weight(sigma_t + (fog_ext[0] - ext_before) / seg, seg, depth + ext_before, riemann);
@@ -383,6 +500,13 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
           continue;
         }
         if (!(sigma_t > (VOL_REAL)0)) continue;
+        if (n_lights > 0) {
+          const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sigma_t, height ? depth + fog_ext[0] : depth, each,
+                                              mask, vols, count, no_fog, lights, n_lights, l_in, l_out, features);
+          i_r += l.x;
+          i_g += l.y;
+          i_b += l.z;
+        }
         const VOL_REAL scatter = vol_segment_weight(sigma_t, seg, height ? depth + fog_ext[0] : depth, riemann);
         i_r += source.x * scatter;
         i_g += source.y * scatter;

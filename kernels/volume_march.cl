@@ -15,6 +15,8 @@
  *   VOL_LANES        target pixels per work-item: 16 on CPU devices (noise as a buffer), else 1
  *   VOL_HEIGHT_FEATURES  with VOL_FEATURE_HEIGHT: the marched height fog's FOG_HF_* bits
  *                    (docs/DESIGN.md §6.5); one pixel per work-item (the lanes do not carry it)
+ *   VOL_FEATURE_LIGHTS / VOL_FEATURE_SPOT in VOL_FEATURES: local lights, read after the volumes
+ *                    (VOL_F_LIGHT_OFFSET); one pixel per work-item (the lanes do not carry them)
  *
  * Why 16 pixels per work-item on CPUs (docs/volumetric.md §Lanes on CPU devices): PoCL vectorises
  * only across work-items, and the march's per-ray loops and branches keep it out, so each core
@@ -81,6 +83,9 @@ kernel void volume_march(global const float* depth, global const float* frame, g
 #elif VOL_LANES == 16
 #if VOL_FEATURES & VOL_FEATURE_HEIGHT
 #error "the marched height fog runs one pixel per work-item"
+#endif
+#if VOL_FEATURES & VOL_FEATURE_LIGHTS
+#error "local lights run one pixel per work-item"
 #endif
 #ifdef VOL_NOISE_IMAGE
 #error "VOL_LANES 16 reads the noise as a buffer"
@@ -317,7 +322,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     vol_float3x16 source;
     const uint16 volumes_here = alive ? vload16(0, mask) : (uint16)0u;
     const float16 sigma_t = vol_physical_sample(p, t, phase, lit, volumes_here, volumes, count, frame, noise,
-                                                noise_size, VOL_FEATURES, &source);
+                                                noise_size, VOL_FEATURES, &source, 0);
     const int16 adds = sigma_t > 0.0f;
     if (VOL_ANY16(adds)) {
       const float16 scatter = vol_segment_weight(sigma_t, seg, optical, VOL_INTEGRATOR == VOL_RIEMANN);

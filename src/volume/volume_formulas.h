@@ -21,6 +21,8 @@ using glm::dot;
 using glm::floor;
 using glm::length;
 using glm::normalize;
+using std::atan;
+using std::ceil;
 using std::exp;
 using std::expm1;
 using std::floor;
@@ -28,6 +30,7 @@ using std::max;
 using std::min;
 using std::pow;
 using std::size_t;
+using std::tan;
 
 #include "volume_common.h"
 #include "volume_ray.h"

@@ -117,10 +117,12 @@ void validate(const LocalLight& l, std::size_t index) {
   c.real("range", l.range, 0.0f, true, kMaxLightRange, false, "must be finite and in (0, 1e15]");
   c.real("radius", l.radius, 0.0f, true, l.range, false, "must be finite and in (0, range]");
   const float brightest = std::max({l.color.x, l.color.y, l.color.z});
-  const double peak = double(l.intensity) * double(brightest) / (double(l.radius) * double(l.radius));
+  const double peak =
+      double(l.intensity) * double(brightest) * std::max(1.0, 1.0 / (double(l.radius) * double(l.radius)));
   if (!(peak <= kMaxLightPeak))
     c.fail("intensity",
-           "* max(color) / radius^2 must be <= 1e30 (the light's peak at its source must stay within float range)",
+           "* max(color) * max(1, 1 / radius^2) must be <= 1e30 (the light's peak at its source must stay within "
+           "float range)",
            str(peak));
   if (l.kind != LightKind::spot) return;
   if (!finite(l.direction) || glm::length(l.direction) == 0.0f)
@@ -394,6 +396,55 @@ void pack_height_fog(PackedVolumeFrame& out, const FogSettings& fog, const Camer
   // An infinite ray marches to the far plane (an infinite far plane: no stretch, the tail alone).
   k[VOL_F_HEIGHT_REACH] = camera.projection == Projection::perspective_infinite_far ? 0.0f : camera.far_plane();
 }
+// The local lights that can add light (docs/volumetric.md#local-lights) after the volumes: a black
+// light, or one whose range sphere meets no visible volume (without the marched height fog, which
+// fills the view), adds exactly 0 and is left out; none left, no light code in the variant.
+static_assert(kMaxLocalLights == VOL_MAX_LIGHTS, "fogcl/volumes.h and kernels/volume_integrate.h agree");
+constexpr double kRadiansPerDegree = 3.14159265358979323846 / 180.0;
+void pack_lights(PackedVolumeFrame& out, const VolumeScene& scene) {
+  const bool height = (out.variant.features & VOL_FEATURE_HEIGHT) != 0;
+  if (out.visible.empty() && !height) return;  // no medium to glow in
+  std::vector<float> packed;
+  int spots = 0;
+  for (const LocalLight& l : scene.lights) {
+    if (l.intensity == 0.0f || std::max({l.color.x, l.color.y, l.color.z}) == 0.0f) continue;
+    bool reaches = height;
+    for (std::size_t index : out.visible) {
+      const FogVolume& v = scene.volumes[index];
+      reaches = reaches || double(glm::length(glm::dvec3(l.position) - glm::dvec3(v.center))) <
+                               double(l.range) + double(v.radius);
+    }
+    if (!reaches) continue;
+    float p[VOL_L_STRIDE] = {};
+    const auto put3 = [&](int at, const glm::vec3& x) { p[at] = x.x, p[at + 1] = x.y, p[at + 2] = x.z; };
+    put3(VOL_L_POSITION, l.position);
+    put3(VOL_L_RADIANCE, l.intensity * l.color);
+    p[VOL_L_RANGE] = l.range;
+    p[VOL_L_INV_RANGE2] = float(1.0 / (double(l.range) * double(l.range)));
+    p[VOL_L_RADIUS2] = l.radius * l.radius;
+    p[VOL_L_SPOT_SCALE] = 0.0f;  // a point light: the cone's factor is saturate(1)^2 = 1
+    p[VOL_L_SPOT_OFFSET] = 1.0f;
+    if (l.kind == LightKind::spot) {
+      put3(VOL_L_AXIS, glm::vec3(glm::normalize(glm::dvec3(l.direction))));
+      const double inner = std::cos(double(l.inner_angle) * kRadiansPerDegree);
+      const double outer = std::cos(double(l.outer_angle) * kRadiansPerDegree);
+      const double scale = 1.0 / std::max(inner - outer, 1e-4);
+      p[VOL_L_SPOT_SCALE] = float(scale);
+      p[VOL_L_SPOT_OFFSET] = float(-outer * scale);
+      ++spots;
+    }
+    packed.insert(packed.end(), p, p + VOL_L_STRIDE);
+  }
+  const std::size_t n = packed.size() / VOL_L_STRIDE;
+  if (n == 0) return;
+  if (n > VOL_MAX_LIGHTS)
+    throw Error(std::to_string(n) + " local lights reach a visible medium in this frame; at most " +
+                std::to_string(VOL_MAX_LIGHTS) + " are supported");
+  out.variant.features |= VOL_FEATURE_LIGHTS | (spots > 0 ? VOL_FEATURE_SPOT : 0);
+  out.frame[VOL_F_LIGHT_COUNT] = float(n);
+  out.frame[VOL_F_LIGHT_OFFSET] = float(out.volumes.size());
+  out.volumes.insert(out.volumes.end(), packed.begin(), packed.end());
+}
 }  // namespace
 
 PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& camera, const VolumeScene& scene,
@@ -509,6 +560,7 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
     k[VOL_F_SHADOW_BIAS] = shadow->bias;
   }
   if (settings.height_fog) pack_height_fog(out, *settings.height_fog, camera, scene.pose);
+  pack_lights(out, scene);
   return out;
 }
 
@@ -525,8 +577,9 @@ int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
   // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
   // work-items, which the march's loops prevent; the lanes instance has no image sampling.
   const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
-  // The marched height fog runs one pixel per work-item: the lanes instance does not carry it.
-  if (v.features & VOL_FEATURE_HEIGHT) return 1;
+  // The marched height fog and the local lights run one pixel per work-item: the lanes instance
+  // does not carry them.
+  if (v.features & (VOL_FEATURE_HEIGHT | VOL_FEATURE_LIGHTS)) return 1;
   return pixels_per_work_item(device) == 16 && buffer ? 16 : 1;
 }
 
@@ -551,14 +604,16 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
 // ray, its occluder, key, jitter and result (13); the staging of the noise and shadow-map helpers
 // inlined into it (10); the stylized march's per-volume entries (7), or the physical walk's state
 // (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES); with the marched height
-// fog its FOG_HP_* constants and its per-channel sums (20). Twice that for what the
+// fog its FOG_HP_* constants and its per-channel sums (20); with local lights their spans along the
+// ray and the volumes' extinctions of a segment (2 x VOL_MAX_LIGHTS + VOL_MAX_VOLUMES). Twice that for what the
 // compiler keeps besides (spilled vectors, copies): PoCL 3.1's work-group functions hold 0.9-1.15x
 // the arrays per work-item (their stack frames: 6.4-6.8 KB physical, 1.7-2.2 KB stylized at 16
 // lanes).
 std::size_t volume_march_private_bytes(const VolumeVariant& v, const DeviceTraits& device) {
   const std::size_t per_lane =
       13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES) +
-      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 20 : 0);  // the marched fog's constants and sums
+      ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 20 : 0) +  // the marched fog's constants and sums
+      ((v.features & VOL_FEATURE_LIGHTS) ? 2 * VOL_MAX_LIGHTS + VOL_MAX_VOLUMES : 0);  // light spans, extinctions
   return 2 * 4 * per_lane * std::size_t(volume_march_lanes(v, device));
 }
 

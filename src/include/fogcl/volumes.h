@@ -75,7 +75,8 @@ struct LocalLight {
   glm::vec3 position{0.0f};             // [world], finite
   glm::vec3 color{1.0f};                // linear RGB, finite, >= 0
   // Radiant intensity of color 1 [radiance x world^2, the main light's irradiance x world^2]:
-  // finite, >= 0. intensity * max(color) / radius^2 must be <= 1e30 (the peak stays in float).
+  // finite, >= 0. intensity * max(color) * max(1, 1 / radius^2) must be <= 1e30 (the peak stays
+  // in float).
   float intensity = 1.0f;
   float range = 10.0f;                  // [world], finite, in (0, 1e15]: nothing beyond it
   // Source radius [world], finite, in (0, range]: the inverse square is 1 / (d^2 + radius^2), so
