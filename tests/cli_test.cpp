@@ -2,12 +2,14 @@
 // compared against the library's double path; bad input exits non-zero with one line and no file.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "fogcl/demo_scene.h"
 #include "fogcl/exr_io.h"
 #include "test_support.h"
 
@@ -107,6 +109,56 @@ TEST_F(Cli, DemoShaftRowHasShafts) {
   EXPECT_GT(pct, 2.0);
   EXPECT_LT(pct, 90.0) << "shafts, not a shadow over everything";
   EXPECT_GE(most_runs, 2u) << "lit and shadowed columns alternate";
+}
+
+// The street-lamp row: the lamps only add light to the night mist, and most of it near them: the
+// mean added luminance in a disc around each lamp's image is several times the frame's mean.
+TEST_F(Cli, DemoLampRowIsBrighterNearTheLamps) {
+  const std::string kind = runtime() ? "opencl" : "scalar";
+  for (const char* row : {"street-lamps ", "street-lamps-off "})
+    EXPECT_NE(demo_output_.find(row), std::string::npos) << row << " in " << demo_output_;
+  const ColorImage on = read_exr_color(in("street-lamps-" + kind + ".exr"));
+  const ColorImage off = read_exr_color(in("street-lamps-off-" + kind + ".exr"));
+  ASSERT_EQ(on.size_bytes(), off.size_bytes());
+  const auto luminance = [](const glm::vec4& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; };
+  double darker = 0.0, mean = 0.0;
+  for (int y = 0; y < on.height(); ++y)
+    for (int x = 0; x < on.width(); ++x) {
+      const double d = luminance(on.pixel(x, y)) - luminance(off.pixel(x, y));
+      for (int c = 0; c < 3; ++c) darker = std::max(darker, double(off.pixel(x, y)[c]) - double(on.pixel(x, y)[c]));
+      mean += d / double(on.pixel_count());
+    }
+  // Each lamp's image position: the demo camera (fogcl's left-handed world, 60 degrees vertical).
+  const DemoView view;
+  const glm::vec3 forward = glm::normalize(view.target - view.eye);
+  const glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0.0f, 1.0f, 0.0f), forward));
+  const glm::vec3 up = glm::cross(forward, right);
+  const double tan_half = std::tan(30.0 * 3.14159265358979 / 180.0), aspect = double(on.width()) / on.height();
+  const int r = std::max(2, on.height() / 20);
+  std::size_t lamps_in_view = 0;
+  for (const LocalLight& l : demo_street_lamps()) {
+    const glm::vec3 p = l.position - view.eye;
+    const double z = glm::dot(p, forward);
+    const double u = (1.0 + glm::dot(p, right) / (z * tan_half * aspect)) * 0.5 * on.width();
+    const double v = (1.0 - glm::dot(p, up) / (z * tan_half)) * 0.5 * on.height();
+    if (!(z > 0.0 && u >= r && u < on.width() - r && v >= r && v < on.height() - r)) continue;
+    ++lamps_in_view;
+    double near = 0.0;
+    int n = 0;
+    for (int y = int(v) - r; y <= int(v) + r; ++y)
+      for (int x = int(u) - r; x <= int(u) + r; ++x) {
+        near += luminance(on.pixel(x, y)) - luminance(off.pixel(x, y));
+        ++n;
+      }
+    near /= n;
+    std::printf("[ measured ] lamp at (%g, %g, %g), pixel (%.0f, %.0f): %.3g added near it, %.3g on the frame's mean\n",
+                double(l.position.x), double(l.position.y), double(l.position.z), u, v, near, mean);
+    EXPECT_GT(near, 3.0 * mean) << "lamp at pixel " << u << "," << v;
+  }
+  std::printf("[ measured ] street-lamps vs off: %zu lamps in view, up to %.3g darker\n", lamps_in_view, darker);
+  EXPECT_GE(lamps_in_view, 4u);
+  EXPECT_GT(mean, 0.0);
+  EXPECT_LE(darker, 1e-5) << "a lamp never takes light away";
 }
 
 TEST_F(Cli, ApplyMatchesTheDoublePath) {

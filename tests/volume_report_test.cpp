@@ -52,9 +52,9 @@ const VolumeReportRow* find(const VolumeReport& r, const std::string& scene, Vol
 TEST(VolumeReport, RowsAreSaneAndFilesAreWritten) {
   FOGCL_REQUIRE_DEVICE();
   const VolumeReport r = run_volume_report(*runtime(), small_report());
-  // 4 volume scenes x 2 integrators x 2 steps x 3 resolutions/upsamplings, the light-shaft scene's
-  // physical rows, + 2 Riemann rows.
-  ASSERT_EQ(r.rows.size(), 4u * 2 * 2 * 3 + 2 * 3 + 2);
+  // 4 volume scenes x 2 integrators x 2 steps x 3 resolutions/upsamplings, the light-shaft and the
+  // street-lamp scenes' physical rows, + 2 Riemann rows.
+  ASSERT_EQ(r.rows.size(), 4u * 2 * 2 * 3 + 2 * 2 * 3 + 2);
   EXPECT_EQ(r.reference_steps, 4096);
   for (const VolumeReportRow& row : r.rows) {
     std::printf("[ vreport ] %-7s %-44s %8.3f ms  max %.3g  p999 %.3g  8bit %.3g%%  nonfinite %zu\n", row.scene.c_str(),
@@ -106,7 +106,7 @@ TEST(VolumeReport, RowsAreSaneAndFilesAreWritten) {
   ASSERT_TRUE(fs::exists(dir + "/volume-report.png"));
   // src/report/plot_volume_report.py: a 5.4 x 4.3 inch panel per scene and one for the Riemann
   // rows, 100 dpi.
-  expect_plot(dir + "/volume-report.png", 5 + 1, 5.4, 4.3, 100);
+  expect_plot(dir + "/volume-report.png", 6 + 1, 5.4, 4.3, 100);
 }
 
 // The marched height fog's rows: physical only (its integrator), and at full resolution the shafts'
@@ -141,6 +141,26 @@ TEST(VolumeReport, ShaftErrorShrinksWithSteps) {
     }
     prev = row;
   }
+}
+
+// The street lamps in the marched mist: physical rows only; at full resolution the error (the
+// per-piece transmittance, mist density, cone and phase) shrinks with the steps.
+TEST(VolumeReport, LampErrorShrinksWithSteps) {
+  FOGCL_REQUIRE_DEVICE();
+  VolumeReportOptions o = small_report();
+  o.scenes = {"lamps"};
+  o.divisors = {1};
+  const VolumeReport r = run_volume_report(*runtime(), o);
+  ASSERT_EQ(r.rows.size(), 2u) << "8 and 64 steps, full resolution, physical only";
+  const VolumeReportRow* coarse = find(r, "lamps", VolumeIntegrator::physical, 8, 1);
+  const VolumeReportRow* fine = find(r, "lamps", VolumeIntegrator::physical, 64, 1);
+  ASSERT_TRUE(coarse && fine);
+  std::printf("  lamps, full resolution: max error %.3g (8 steps) -> %.3g (64 steps), p99.9 %.3g -> %.3g\n",
+              coarse->max_abs_err, fine->max_abs_err, coarse->p999_abs_err, fine->p999_abs_err);
+  EXPECT_EQ(coarse->nonfinite + fine->nonfinite, 0u);
+  EXPECT_GT(coarse->max_abs_err, 0.0);
+  EXPECT_LT(fine->max_abs_err, 0.5 * coarse->max_abs_err);
+  EXPECT_LT(fine->p999_abs_err, 0.5 * coarse->p999_abs_err);
 }
 
 TEST(VolumeReport, PhysicalErrorShrinksWithStepsOnTheDemo) {
@@ -412,7 +432,7 @@ TEST(VolumeReportCli, BadFlagsAreOneLineErrors) {
       {"--volumetric --integrators riemann", "--integrators must be one of stylized or physical (got 'riemann')"},
       {"--volumetric --runs 2 --device " + cli_device(), "--runs must be >= 3 with --volumetric (got 2)"},
       {"--volumetric --scenes fog,dense --device " + cli_device(),
-       "--scenes must be one of demo, dense, thin, inside or shafts (got 'fog') in 'fog,dense'"},
+       "--scenes must be one of demo, dense, thin, inside, shafts or lamps (got 'fog') in 'fog,dense'"},
       {"--steps 8", "--steps selects volumetric variants; it needs --volumetric"},
       {"--runs 5", "--runs must be >= 7 for the deferred report (got 5)"},
   };

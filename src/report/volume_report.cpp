@@ -151,7 +151,8 @@ DeviceResult device_run(const Runtime& rt, VolumePass& pass, const ColorImage& i
 
 // A scene's frame, camera and light, and what the pass takes besides the volumes: the demo's view;
 // the volume scenes under the demo's light, the light-shaft scene under its low sun ahead, with
-// its shadow map and its marched fog (fogcl/demo_scene.h).
+// its shadow map and its marched fog, the lamps' scene at night with its street lamps and mist
+// (fogcl/demo_scene.h).
 struct SceneSetup {
   DemoFrame frame;
   float max_eye = 0;
@@ -163,10 +164,16 @@ struct SceneSetup {
 SceneSetup scene_setup(const std::string& name, int width, int height) {
   SceneSetup s;
   const DemoView view;
-  const bool shafts = volume_report_scene_marches_height_fog(name);
-  const MainLight light = shafts ? demo_low_sun() : demo_light();
-  s.frame = render_demo_scene(width, height, PerspectiveCamera{}, view, ColorFormat::rgba32f,
-                              shafts ? std::optional<glm::vec3>(light.direction) : std::nullopt);
+  const bool shafts = name == "shafts", lamps = name == "lamps";
+  MainLight light = shafts ? demo_low_sun() : demo_light();
+  s.frame = lamps ? demo_night_frame(width, height)
+                  : render_demo_scene(width, height, PerspectiveCamera{}, view, ColorFormat::rgba32f,
+                                      shafts ? std::optional<glm::vec3>(light.direction) : std::nullopt);
+  if (lamps) {
+    light.color = glm::vec3(0.0f);  // night: the lamps and the mist's ambient light it
+    s.base.lights = demo_street_lamps();
+    s.height_fog = demo_night_fog();
+  }
   s.max_eye = max_eye_depth(s.frame.depth, s.frame.params);
   s.base.pose = CameraPose{view.eye, view.target - view.eye, glm::vec3(0.0f, 1.0f, 0.0f)};
   s.base.light = light;
@@ -229,9 +236,11 @@ void validate(const VolumeReportOptions& o) {
     throw Error("volume report needs at least one step count, resolution, integrator, storage and noise sampling");
 }
 
-std::vector<std::string> volume_report_scene_names() { return {"demo", "dense", "thin", "inside", "shafts"}; }
+std::vector<std::string> volume_report_scene_names() {
+  return {"demo", "dense", "thin", "inside", "shafts", "lamps"};
+}
 
-bool volume_report_scene_marches_height_fog(const std::string& scene) { return scene == "shafts"; }
+bool volume_report_scene_marches_height_fog(const std::string& scene) { return scene == "shafts" || scene == "lamps"; }
 
 std::string volume_quality_name(int steps, int divisor, VolumeUpsampling upsampling, NoiseSampling noise) {
   std::string s = "s" + std::to_string(steps) + " " + resolution_name(divisor);

@@ -96,4 +96,19 @@ std::vector<FogVolume> demo_fog_volumes(VolumeIntegrator integrator);
 // render_demo_shadow_map(..., demo_low_sun().direction) map cuts shafts into it.
 FogSettings demo_shaft_fog();
 
+// Street lamps for the night scenes (fogcl demo's street-lamps rows, the volume report's "lamps"):
+// four spot lights on 4.5-unit poles pointing down (warm, intensity 50, range 14, cones 20-38
+// degrees), three along the left of the default view and one on the right, and two point-light
+// lanterns near the ground (cool blue and orange).
+std::vector<LocalLight> demo_street_lamps();
+
+// The night scenes' fog: a ground mist (FogMode::height, beta = 0.12 at y = 0, falloff 0.25,
+// fogged sky, cut off at 60 units) lit by a dim blue ambient and no sun lobe, marched with
+// VolumeSettings::height_fog so the lamps glow in it. The night frame is demo_night_frame()'s.
+FogSettings demo_night_fog();
+
+// The demo frame at night: render_demo_scene's colors times 0.04 (depth unchanged), so the fog's
+// lamps are what lights the view.
+DemoFrame demo_night_frame(int width, int height);
+
 }  // namespace fogcl
