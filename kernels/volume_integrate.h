@@ -255,15 +255,18 @@ VOL_FN VOL_REAL vol_covered(const VOL_REAL* t_in, const VOL_REAL* t_out, VOL_UIN
 }
 
 /* Local lights (docs/volumetric.md#local-lights). The ray's stretch inside each light's range
- * sphere, clipped to [0, t_scene], once per ray: a segment outside it skips the light. */
-VOL_FN void vol_light_spans(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_GLOBAL const float* lights, int n,
-                            VOL_REAL* l_in, VOL_REAL* l_out) {
+ * sphere, clipped to [t_from, t_scene], once per ray: a segment outside it skips the light.
+ * t_from <= 0 is where the march starts (the marched height fog starts at the eye, before the
+ * ray's origin on the near plane). */
+VOL_FN void vol_light_spans(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_from, VOL_REAL t_scene,
+                            VOL_GLOBAL const float* lights, int n, VOL_REAL* l_in, VOL_REAL* l_out) {
+  const VOL_V3 from = origin + dir * t_from;
   for (int k = 0; k < n; ++k) {
     VOL_GLOBAL const float* light = lights + k * VOL_L_STRIDE;
     VOL_REAL t0, t1;
-    const int hit = vol_sphere_hit(origin, dir, VOL_P3(light, VOL_L_POSITION), VOL_P(light, VOL_L_RANGE), &t0, &t1);
-    l_in[k] = hit ? t0 : (VOL_REAL)INFINITY;
-    l_out[k] = hit ? fmin(t1, t_scene) : (VOL_REAL)0;
+    const int hit = vol_sphere_hit(from, dir, VOL_P3(light, VOL_L_POSITION), VOL_P(light, VOL_L_RANGE), &t0, &t1);
+    l_in[k] = hit ? t_from + t0 : (VOL_REAL)INFINITY;
+    l_out[k] = hit ? fmin(t_from + t1, t_scene) : (VOL_REAL)0;
   }
 }
 
@@ -445,7 +448,7 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
   const int n_lights = (features & VOL_FEATURE_LIGHTS) ? (int)VOL_P(frame, VOL_F_LIGHT_COUNT) : 0;
   VOL_GLOBAL const float* lights = vols + ((features & VOL_FEATURE_LIGHTS) ? (int)VOL_P(frame, VOL_F_LIGHT_OFFSET) : 0);
   VOL_REAL l_in[VOL_MAX_LIGHTS], l_out[VOL_MAX_LIGHTS], each[VOL_MAX_VOLUMES];
-  if (n_lights > 0) vol_light_spans(origin, dir, t_scene, lights, n_lights, l_in, l_out);
+  if (n_lights > 0) vol_light_spans(origin, dir, fmin(start, (VOL_REAL)0), t_scene, lights, n_lights, l_in, l_out);
   const VOL_V3 no_fog = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   VOL_REAL phase[VOL_MAX_VOLUMES];
   vol_physical_phases(dot(dir, VOL_P3(frame, VOL_F_LIGHT_DIR)), vols, count, phase);

@@ -156,6 +156,42 @@ TEST_F(CliVolumes, ScalarPathEqualsTheLibraryBitForBit) {
   EXPECT_LE(max_abs_rgb_error(got, ref), 1e-4);
 }
 
+// VOLUMES.json's "lights" reach the pass: the CLI's image is the library's with the same lights,
+// bit for bit, and differs from the one without them; the stylized integrator refuses them.
+TEST_F(CliVolumes, LightsInTheFileReachThePass) {
+  LocalLight lamp;
+  lamp.position = {2.0f, 1.5f, 2.0f};
+  lamp.color = {1.0f, 0.7f, 0.4f};
+  lamp.intensity = 30.0f;
+  lamp.range = 6.0f;
+  LocalLight spot = lamp;
+  spot.kind = LightKind::spot;
+  spot.position = {-4.0f, 5.0f, 11.0f};
+  spot.direction = {0.0f, -1.0f, 0.1f};
+  spot.inner_angle = 10.0f;
+  spot.outer_angle = 30.0f;
+  write_text(in("lights.json"), volumes_to_json(test_volumes(), {lamp, spot}));
+  const std::string args = base_args({{"--volumes", in("lights.json")}}) + " --device scalar --integrator physical";
+  const ColorImage got = run_ok(args, "lights.exr");
+  ASSERT_GT(got.width(), 0);
+  VolumeScene s = scene();
+  s.lights = {lamp, spot};
+  VolumeSettings physical;
+  physical.integrator = VolumeIntegrator::physical;
+  ColorImage want, dark;
+  apply_volumes_scalar(frame_->color, frame_->depth, want, frame_->params, s, physical);
+  s.lights.clear();
+  apply_volumes_scalar(frame_->color, frame_->depth, dark, frame_->params, s, physical);
+  const std::size_t diff = differing_floats(got, want), lit = differing_floats(got, dark);
+  std::printf("[ measured ] CLI with 2 lights vs the library: %zu differing floats; %zu floats lit by them\n", diff, lit);
+  EXPECT_EQ(diff, 0u);
+  EXPECT_GT(lit, 0u);
+  const CliRun r = run_cli(base_args({{"--volumes", in("lights.json")}}) + " --device scalar --out " + in("no.exr"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_MSG_HAS(r.output, "fogcl: error: ");
+  EXPECT_MSG_HAS(r.output, "local lights need the physical integrator (got stylized, with 2 lights)");
+}
+
 TEST_F(CliVolumes, OpenCLPathEqualsVolumePassBitForBit) {
   FOGCL_REQUIRE_DEVICE();
   std::string output;

@@ -91,20 +91,30 @@ glm::dvec3 inscattered(const glm::dvec3& o, const glm::dvec3& d, double t_end, c
       }
     }
   };
+  // Each piece's panels are graded geometrically toward both ends (from 1e-12 of its length to the
+  // middle): a light's peak, 1 / radius^2 wide radius, sits at a cut and is resolved at any radius.
   Real sum[3] = {0, 0, 0};
+  const long half_panels = std::max(1L, panels / 2);
   for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
     const Real a = cuts[k], b = cuts[k + 1];
     if (!(b > a)) continue;
-    const Real h = (b - a) / Real(panels);
-    for (long j = 0; j < panels; ++j) {
-      const Real mid = a + h * (Real(j) + 0.5L), half = h / 2;
-      for (int q = 0; q < 8; ++q) {
-        const Real x = q < 4 ? -kNode[q] : kNode[q - 4], w = kWeight[q < 4 ? q : q - 4];
-        Real f[3];
-        integrand(mid + half * x, f);
-        for (int c = 0; c < 3; ++c) sum[c] += w * half * f[c];
+    for (int side = 0; side < 2; ++side)
+      for (long j = 0; j < half_panels; ++j) {
+        // x in [0, 1/2] from the end: 0, then 1e-12 .. 1/2 log-spaced.
+        const auto at = [&](long i) {
+          return i == 0 ? Real(0) : 0.5L * std::pow(10.0L, -12.0L * Real(half_panels - i) / Real(half_panels - 1));
+        };
+        const Real x0 = at(j), x1 = at(j + 1);
+        const Real lo = side == 0 ? a + (b - a) * x0 : b - (b - a) * x1;
+        const Real hi = side == 0 ? a + (b - a) * x1 : b - (b - a) * x0;
+        const Real mid = (lo + hi) / 2, half = (hi - lo) / 2;
+        for (int q = 0; q < 8; ++q) {
+          const Real x = q < 4 ? -kNode[q] : kNode[q - 4], w = kWeight[q < 4 ? q : q - 4];
+          Real f[3];
+          integrand(mid + half * x, f);
+          for (int c = 0; c < 3; ++c) sum[c] += w * half * f[c];
+        }
       }
-    }
   }
   return glm::dvec3(double(sum[0]), double(sum[1]), double(sum[2]));
 }

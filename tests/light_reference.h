@@ -27,7 +27,7 @@ struct Medium {
 // finite): ∫ T(t) Σ_media albedo σ_t HG(cos θ) I color W(d) cone / (d² + radius²) dt, T(t) the
 // media's transmittance from the origin. The integral is cut at every sphere boundary, every
 // light's range sphere and its closest approach, and each piece takes `panels` panels of 8-point
-// Gauss-Legendre quadrature.
+// Gauss-Legendre quadrature, graded geometrically toward the piece's ends (where a light's peak is).
 glm::dvec3 inscattered(const glm::dvec3& origin, const glm::dvec3& dir, double t_end, const std::vector<Medium>& media,
                        const std::vector<LocalLight>& lights, long panels);
 

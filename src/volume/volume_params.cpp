@@ -465,7 +465,9 @@ PackedVolumeFrame pack_volume_frame(int width, int height, const CameraParams& c
   }
   if (!scene.lights.empty() && settings.integrator == VolumeIntegrator::stylized)
     throw Error("local lights need the physical integrator (got stylized, with " + std::to_string(scene.lights.size()) +
-                " lights): the seed's accumulator has no per-sample light to add them to");
+                (scene.lights.size() == 1 ? " light" : " lights") +
+                "): the seed's accumulator has no per-sample light to add them to (VolumeSettings::integrator; "
+                "fogcl apply --integrator physical)");
   PackedVolumeFrame out;
   out.visible = visible_volumes(scene, camera, max_eye_depth);  // validates scene and camera
   if (out.visible.size() > VOL_MAX_VOLUMES)
