@@ -112,7 +112,8 @@ TEST_F(Cli, DemoShaftRowHasShafts) {
 }
 
 // The street-lamp row: the lamps only add light to the night mist, and most of it near them: the
-// mean added luminance in a disc around each lamp's image is several times the frame's mean.
+// mean added luminance in a square around each lamp's image (a spot's: 1.5 units into its cone) is
+// several times the frame's mean.
 TEST_F(Cli, DemoLampRowIsBrighterNearTheLamps) {
   const std::string kind = runtime() ? "opencl" : "scalar";
   for (const char* row : {"street-lamps ", "street-lamps-off "})
@@ -137,7 +138,9 @@ TEST_F(Cli, DemoLampRowIsBrighterNearTheLamps) {
   const int r = std::max(2, on.height() / 20);
   std::size_t lamps_in_view = 0;
   for (const LocalLight& l : demo_street_lamps()) {
-    const glm::vec3 p = l.position - view.eye;
+    // A spot's glow is its cone: look 1.5 units down its axis; a point light's is around it.
+    const glm::vec3 at = l.kind == LightKind::spot ? l.position + 1.5f * glm::normalize(l.direction) : l.position;
+    const glm::vec3 p = at - view.eye;
     const double z = glm::dot(p, forward);
     const double u = (1.0 + glm::dot(p, right) / (z * tan_half * aspect)) * 0.5 * on.width();
     const double v = (1.0 - glm::dot(p, up) / (z * tan_half)) * 0.5 * on.height();
