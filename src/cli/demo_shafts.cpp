@@ -79,19 +79,22 @@ void run_demo_shafts(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>
   settings.integrator = VolumeIntegrator::physical;  // the marched fog's integrator
 
   const MainLight sun = demo_low_sun();
-  const DemoFrame day = render_demo_scene(o.width, o.height, PerspectiveCamera{}, view, ColorFormat::rgba32f,
-                                          sun.direction);
-  write_exr_rgba(path("scene-low-sun.exr"), day.color);
-  write_png_preview(path("scene-low-sun.png"), day.color);
-  const ShadowMap shadow = render_demo_shadow_map(1024, 1024, DemoShadowRegion{}, sun.direction);
-  scene.light = sun;
-  settings.height_fog = demo_shaft_fog();
-  std::printf(
-      "\nlight shafts (the height fog marched, docs/DESIGN.md §6.5): a low sun ahead, %d steps, half resolution, "
-      "depth-aware; shadow map %dx%d\n",
-      settings.steps, shadow.depth.width(), shadow.depth.height());
-  std::printf("(opencl: median of 3 runs after a warm-up; scalar: 1 run)\n");
-  run_rows(o, backends, settings, 3, {{"height-shafts", &day, scene, &shadow}, {"height-shafts-lit", &day, scene, nullptr}});
+  {  // one scene frame at a time (fogcl demo's memory check counts two: cli/frame_memory.cpp)
+    const DemoFrame day = render_demo_scene(o.width, o.height, PerspectiveCamera{}, view, ColorFormat::rgba32f,
+                                            sun.direction);
+    write_exr_rgba(path("scene-low-sun.exr"), day.color);
+    write_png_preview(path("scene-low-sun.png"), day.color);
+    const ShadowMap shadow = render_demo_shadow_map(1024, 1024, DemoShadowRegion{}, sun.direction);
+    scene.light = sun;
+    settings.height_fog = demo_shaft_fog();
+    std::printf(
+        "\nlight shafts (the height fog marched, docs/DESIGN.md §6.5): a low sun ahead, %d steps, half resolution, "
+        "depth-aware; shadow map %dx%d\n",
+        settings.steps, shadow.depth.width(), shadow.depth.height());
+    std::printf("(opencl: median of 3 runs after a warm-up; scalar: 1 run)\n");
+    run_rows(o, backends, settings, 3,
+             {{"height-shafts", &day, scene, &shadow}, {"height-shafts-lit", &day, scene, nullptr}});
+  }
 
   const DemoFrame night = demo_night_frame(o.width, o.height);
   write_exr_rgba(path("scene-night.exr"), night.color);
@@ -108,7 +111,8 @@ void run_demo_shafts(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>
               "resolution, depth-aware\n",
               lamps.lights.size(), settings.steps);
   std::printf("(opencl: 1 run after a warm-up, the lights' march is the demo's slowest; scalar: 1 run)\n");
-  run_rows(o, backends, settings, 1, {{"street-lamps", &night, lamps, nullptr}, {"street-lamps-off", &night, dark, nullptr}});
+  run_rows(o, backends, settings, 1,
+           {{"street-lamps", &night, lamps, nullptr}, {"street-lamps-off", &night, dark, nullptr}});
 }
 
 }  // namespace fogcl::cli

@@ -187,7 +187,8 @@ VolumeQualityChoice choose_volume_quality(const Runtime& runtime, const VolumeSe
   }
   if (best == nullptr) throw Error("volumetric error budget: the measurement has no variant");
   throw Error("no volumetric variant meets the error budget (max error " + short_num(max_error) + ") with the " +
-              to_string(base.integrator) + " integrator" + (base.height_fog ? ", the marched height fog" : "") + " and " + to_string(storage) + " storage on " + key.device +
+              to_string(base.integrator) + " integrator" + (base.height_fog ? ", the marched height fog" : "") +
+              " and " + to_string(storage) + " storage on " + key.device +
               ": the best achievable worst color error is " + short_num(best->max_abs_err) + " (" +
               volume_quality_name(best->steps, best->divisor, best->upsampling, best->noise) + ")");
 }
