@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -366,6 +367,85 @@ TEST_F(CliHeight, BadInputIsOneLineNamingTheFlagAndTheRule) {
     EXPECT_NE(r.output.find(c.part), std::string::npos) << c.args << "\n" << r.output;
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
     EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+}
+
+// --height-volumetric's light and shadow flags walked with empty, huge and wrong values: each is one
+// line naming the flag (exit 1, or 2 for malformed text), no file; flags that would change nothing in
+// the marched fog's image (no volumes) are refused; the largest accepted values give a finite image.
+TEST_F(CliHeight, HeightVolumetricLightAndShadowFlagsWalk) {
+  const ShadowMap shadow = render_demo_shadow_map(64, 64);
+  write_exr_depth(in("walk-shadow.exr"), shadow.depth);
+  std::ofstream(in("not-an-exr.exr")) << "{}";
+  std::string m;
+  for (int row = 0; row < 4; ++row)
+    for (int c = 0; c < 4; ++c) {
+      char v[32];
+      std::snprintf(v, sizeof v, "%.9g", double(shadow.params.world_to_light_clip[c][row]));
+      m += (row + c ? "," : "") + std::string(v);
+    }
+  const std::string base = files() + pose_flags() +
+                           " --mode height --density 0.05 --height-falloff 0.3 --height-volumetric --steps 4 "
+                           "--volume-resolution quarter --device scalar";
+  const std::string sm = " --shadow-map " + in("walk-shadow.exr") + " --light-view-proj " + m;
+  struct Case {
+    std::string args, part;
+    int exit_code;
+  };
+  const Case cases[] = {
+      {" --light-dir ''", "--light-dir must be three comma-separated numbers", 2},
+      {" --light-dir 1,2", "--light-dir must be three comma-separated numbers", 2},
+      {" --light-dir a,b,c", "--light-dir must be three comma-separated numbers", 2},
+      {" --light-dir 0,0,0", "--light-dir must be a non-zero vector", 1},
+      {" --light-dir nan,1,0", "--light-dir must be finite", 1},
+      {" --light-dir 1e39,0,1", "--light-dir must be finite", 1},
+      {" --light-dir 3e38,3e38,3e38", "--light-dir is too long to normalise", 1},
+      {" --light-color ''", "--light-color must be three comma-separated numbers", 2},
+      {" --light-color inf,1,1", "--light-color must be finite", 1},
+      {" --light-color -1,0,0", "--light-color must be >= 0", 1},
+      {" --light-color 1,1,1", "--light-color colors the fog volumes' light (--volumes)", 1},
+      {" --shadow-map ''", "--shadow-map must not be empty", 2},
+      {" --shadow-map " + in("none.exr") + " --light-view-proj " + m + " --light-dir 0,1,0 --sun-color 1,1,1",
+       "--shadow-map: " + in("none.exr"), 1},
+      {" --shadow-map " + in("not-an-exr.exr") + " --light-view-proj " + m + " --light-dir 0,1,0 --sun-color 1,1,1",
+       "cannot read EXR", 1},
+      {" --shadow-map " + dir_ + " --light-view-proj " + m, "is a directory", 1},
+      {" --shadow-map " + in("walk-shadow.exr"), "--shadow-map needs --light-view-proj", 1},
+      {" --light-view-proj " + m, "--light-view-proj needs --shadow-map", 1},
+      {" --shadow-reversed-z", "--shadow-reversed-z needs --shadow-map", 1},
+      {" --shadow-map " + in("walk-shadow.exr") + " --light-view-proj 1,2,3", "--light-view-proj must be 16", 2},
+      {" --shadow-map " + in("walk-shadow.exr") + " --light-view-proj ''", "--light-view-proj element 0", 2},
+      {" --shadow-map " + in("walk-shadow.exr") + " --light-view-proj 0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0",
+       "--light-view-proj: light view-projection matrix is singular", 1},
+      {" --shadow-map " + in("walk-shadow.exr") + " --light-view-proj 1e39,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1",
+       "--light-view-proj element (row 0, column 0) must be a finite float", 1},
+      {sm, "--shadow-map with --height-volumetric needs --sun-color", 1},
+      {sm + " --light-dir 0,1,0 --sun-color 1,1,1 --integrator stylized", "--height-volumetric needs --integrator physical",
+       1},
+  };
+  const std::string out = in("walk.exr");
+  for (const Case& c : cases) {
+    fs::remove(out);
+    const CliRun r = run_cli(base + c.args + " --out " + out);
+    std::printf("[ message  ] %s", r.output.c_str());
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.args << "\n" << r.output;
+    EXPECT_EQ(r.output.rfind("fogcl: error: ", 0), 0u) << r.output;
+    EXPECT_NE(r.output.find(c.part), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+  // The largest values each flag takes: a finite image.
+  for (const std::string& ok : {sm + " --light-dir 1e18,1e18,1e18 --sun-color 3e38,3e38,3e38",
+                                sm + " --light-dir 0.3,0.8,-0.5 --sun-color 1,1,1 --sun-exponent 3e38",
+                                sm + " --light-dir 1e-30,1,0 --sun-color 1,1,1 --shadow-reversed-z"}) {
+    const ColorImage img = run_ok(base + ok, "walk-ok.exr");
+    std::size_t nonfinite = 0;
+    for (int y = 0; y < img.height(); ++y)
+      for (int x = 0; x < img.width(); ++x)
+        for (int c = 0; c < 4; ++c) nonfinite += std::isfinite(img.pixel(x, y)[c]) ? 0 : 1;
+    std::printf("[ measured ] %s: %zu non-finite values\n", ok.substr(ok.find("--light-dir")).c_str(), nonfinite);
+    EXPECT_GT(img.width(), 0) << ok;
+    EXPECT_EQ(nonfinite, 0u) << ok;
   }
 }
 

@@ -2,12 +2,14 @@
 // compared against the library's double path; bad input exits non-zero with one line and no file.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "fogcl/demo_scene.h"
 #include "fogcl/exr_io.h"
 #include "test_support.h"
 
@@ -67,6 +69,99 @@ TEST_F(Cli, DemoVolumeRowsAreReproducedByApply) {
   std::printf("[ measured ] demo's fogcl apply line vs its %s row: %s\n", kind.c_str(),
               differing ? "differs" : "bit-identical");
   EXPECT_EQ(differing, 0u);
+}
+
+// The light-shaft rows: the shadow map only takes the sun's light away (never adds), and it cuts
+// shafts: along some image row, shadowed runs of fog alternate with lit ones.
+TEST_F(Cli, DemoShaftRowHasShafts) {
+  const std::string kind = runtime() ? "opencl" : "scalar";
+  for (const char* row : {"height-shafts ", "height-shafts-lit "})
+    EXPECT_NE(demo_output_.find(row), std::string::npos) << row << " in " << demo_output_;
+  const ColorImage shafts = read_exr_color(in("height-shafts-" + kind + ".exr"));
+  const ColorImage lit = read_exr_color(in("height-shafts-lit-" + kind + ".exr"));
+  const ColorImage scene = read_exr_color(in("scene-low-sun.exr"));
+  ASSERT_EQ(shafts.size_bytes(), lit.size_bytes());
+  const auto luminance = [](const glm::vec4& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; };
+  double brighter = 0.0, darkest = 0.0, fog_gain = 0.0;
+  std::size_t shadowed = 0, most_runs = 0;
+  for (int y = 0; y < shafts.height(); ++y) {
+    std::size_t runs = 0;
+    bool in_run = false;
+    for (int x = 0; x < shafts.width(); ++x) {
+      const double d = luminance(lit.pixel(x, y)) - luminance(shafts.pixel(x, y));
+      for (int c = 0; c < 3; ++c)
+        brighter = std::max(brighter, double(shafts.pixel(x, y)[c]) - double(lit.pixel(x, y)[c]));
+      darkest = std::max(darkest, d);
+      fog_gain = std::max(fog_gain, luminance(lit.pixel(x, y)) - luminance(scene.pixel(x, y)));
+      const bool dark = d > 0.02;  // a shadowed stretch of the ray: the sun's glow is missing
+      shadowed += dark ? 1 : 0;
+      if (dark && !in_run) ++runs;
+      in_run = dark;
+    }
+    most_runs = std::max(most_runs, runs);
+  }
+  const double pct = 100.0 * double(shadowed) / double(shafts.pixel_count());
+  std::printf("[ measured ] height-shafts vs its lit row: up to %.3g darker (lit fog adds up to %.3g), %.3g brighter; "
+              "%.1f%% of pixels shadowed; up to %zu separate shadowed runs in one image row\n",
+              darkest, fog_gain, brighter, pct, most_runs);
+  EXPECT_LE(brighter, 1e-5) << "a shadow never adds light";
+  EXPECT_GT(darkest, 0.1) << "the spheres' shadows are visible in the fog";
+  EXPECT_GT(pct, 2.0);
+  EXPECT_LT(pct, 90.0) << "shafts, not a shadow over everything";
+  EXPECT_GE(most_runs, 2u) << "lit and shadowed columns alternate";
+}
+
+// The street-lamp row: the lamps only add light to the night mist, and most of it near them: the
+// mean added luminance in a square around each lamp's image (a spot's: 1.5 units into its cone) is
+// several times the frame's mean.
+TEST_F(Cli, DemoLampRowIsBrighterNearTheLamps) {
+  const std::string kind = runtime() ? "opencl" : "scalar";
+  for (const char* row : {"street-lamps ", "street-lamps-off "})
+    EXPECT_NE(demo_output_.find(row), std::string::npos) << row << " in " << demo_output_;
+  const ColorImage on = read_exr_color(in("street-lamps-" + kind + ".exr"));
+  const ColorImage off = read_exr_color(in("street-lamps-off-" + kind + ".exr"));
+  ASSERT_EQ(on.size_bytes(), off.size_bytes());
+  const auto luminance = [](const glm::vec4& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; };
+  double darker = 0.0, mean = 0.0;
+  for (int y = 0; y < on.height(); ++y)
+    for (int x = 0; x < on.width(); ++x) {
+      const double d = luminance(on.pixel(x, y)) - luminance(off.pixel(x, y));
+      for (int c = 0; c < 3; ++c) darker = std::max(darker, double(off.pixel(x, y)[c]) - double(on.pixel(x, y)[c]));
+      mean += d / double(on.pixel_count());
+    }
+  // Each lamp's image position: the demo camera (fogcl's left-handed world, 60 degrees vertical).
+  const DemoView view;
+  const glm::vec3 forward = glm::normalize(view.target - view.eye);
+  const glm::vec3 right = glm::normalize(glm::cross(glm::vec3(0.0f, 1.0f, 0.0f), forward));
+  const glm::vec3 up = glm::cross(forward, right);
+  const double tan_half = std::tan(30.0 * 3.14159265358979 / 180.0), aspect = double(on.width()) / on.height();
+  const int r = std::max(2, on.height() / 20);
+  std::size_t lamps_in_view = 0;
+  for (const LocalLight& l : demo_street_lamps()) {
+    // A spot's glow is its cone: look 1.5 units down its axis; a point light's is around it.
+    const glm::vec3 at = l.kind == LightKind::spot ? l.position + 1.5f * glm::normalize(l.direction) : l.position;
+    const glm::vec3 p = at - view.eye;
+    const double z = glm::dot(p, forward);
+    const double u = (1.0 + glm::dot(p, right) / (z * tan_half * aspect)) * 0.5 * on.width();
+    const double v = (1.0 - glm::dot(p, up) / (z * tan_half)) * 0.5 * on.height();
+    if (!(z > 0.0 && u >= r && u < on.width() - r && v >= r && v < on.height() - r)) continue;
+    ++lamps_in_view;
+    double near = 0.0;
+    int n = 0;
+    for (int y = int(v) - r; y <= int(v) + r; ++y)
+      for (int x = int(u) - r; x <= int(u) + r; ++x) {
+        near += luminance(on.pixel(x, y)) - luminance(off.pixel(x, y));
+        ++n;
+      }
+    near /= n;
+    std::printf("[ measured ] lamp at (%g, %g, %g), pixel (%.0f, %.0f): %.3g added near it, %.3g on the frame's mean\n",
+                double(l.position.x), double(l.position.y), double(l.position.z), u, v, near, mean);
+    EXPECT_GT(near, 3.0 * mean) << "lamp at pixel " << u << "," << v;
+  }
+  std::printf("[ measured ] street-lamps vs off: %zu lamps in view, up to %.3g darker\n", lamps_in_view, darker);
+  EXPECT_GE(lamps_in_view, 4u);
+  EXPECT_GT(mean, 0.0);
+  EXPECT_LE(darker, 1e-5) << "a lamp never takes light away";
 }
 
 TEST_F(Cli, ApplyMatchesTheDoublePath) {

@@ -52,8 +52,9 @@ const VolumeReportRow* find(const VolumeReport& r, const std::string& scene, Vol
 TEST(VolumeReport, RowsAreSaneAndFilesAreWritten) {
   FOGCL_REQUIRE_DEVICE();
   const VolumeReport r = run_volume_report(*runtime(), small_report());
-  // 4 scenes x 2 integrators x 2 steps x 3 resolutions/upsamplings + 2 Riemann rows.
-  ASSERT_EQ(r.rows.size(), 4u * 2 * 2 * 3 + 2);
+  // 4 volume scenes x 2 integrators x 2 steps x 3 resolutions/upsamplings, the light-shaft and the
+  // street-lamp scenes' physical rows, + 2 Riemann rows.
+  ASSERT_EQ(r.rows.size(), 4u * 2 * 2 * 3 + 2 * 2 * 3 + 2);
   EXPECT_EQ(r.reference_steps, 4096);
   for (const VolumeReportRow& row : r.rows) {
     std::printf("[ vreport ] %-7s %-44s %8.3f ms  max %.3g  p999 %.3g  8bit %.3g%%  nonfinite %zu\n", row.scene.c_str(),
@@ -105,7 +106,61 @@ TEST(VolumeReport, RowsAreSaneAndFilesAreWritten) {
   ASSERT_TRUE(fs::exists(dir + "/volume-report.png"));
   // src/report/plot_volume_report.py: a 5.4 x 4.3 inch panel per scene and one for the Riemann
   // rows, 100 dpi.
-  expect_plot(dir + "/volume-report.png", 4 + 1, 5.4, 4.3, 100);
+  expect_plot(dir + "/volume-report.png", 6 + 1, 5.4, 4.3, 100);
+}
+
+// The marched height fog's rows: physical only (its integrator), and at full resolution the shafts'
+// error (the sun's visibility taken once per segment) shrinks as the steps grow, about as 1 / steps.
+TEST(VolumeReport, ShaftErrorShrinksWithSteps) {
+  FOGCL_REQUIRE_DEVICE();
+  VolumeReportOptions o = small_report();
+  o.width = 48;
+  o.height = 27;
+  o.scenes = {"shafts"};
+  o.steps = {4, 16, 64};
+  o.divisors = {1, 2};
+  const VolumeReport r = run_volume_report(*runtime(), o);
+  ASSERT_EQ(r.rows.size(), 3u * 3) << "3 steps x (full, half depth-aware, half bilinear), physical only";
+  for (const VolumeReportRow& row : r.rows) {
+    std::printf("[ vreport ] %-7s %-44s %8.3f ms  max %.3g  p999 %.3g  8bit %.3g%%\n", row.scene.c_str(),
+                row.variant.c_str(), row.time_ms, row.max_abs_err, row.p999_abs_err, row.pct_8bit_off);
+    EXPECT_EQ(row.integrator, VolumeIntegrator::physical) << row.variant;
+    EXPECT_EQ(row.nonfinite, 0u) << row.variant;
+  }
+  const VolumeReportRow* prev = nullptr;
+  for (int steps : o.steps) {
+    const VolumeReportRow* row = find(r, "shafts", VolumeIntegrator::physical, steps, 1);
+    ASSERT_TRUE(row) << steps;
+    EXPECT_GT(row->max_abs_err, 0.0) << "the shafts are there: a coarse march misses part of them";
+    if (prev != nullptr) {
+      std::printf("  shafts, full resolution: max error %.3g (%d steps) -> %.3g (%d steps)\n", prev->max_abs_err,
+                  prev->steps, row->max_abs_err, steps);
+      // 4x the steps: the error falls about 4x; half of that is the property.
+      EXPECT_LT(row->max_abs_err, 0.5 * prev->max_abs_err) << steps;
+      EXPECT_LT(row->p999_abs_err, 0.5 * prev->p999_abs_err) << steps;
+    }
+    prev = row;
+  }
+}
+
+// The street lamps in the marched mist: physical rows only; at full resolution the error (the
+// per-piece transmittance, mist density, cone and phase) shrinks with the steps.
+TEST(VolumeReport, LampErrorShrinksWithSteps) {
+  FOGCL_REQUIRE_DEVICE();
+  VolumeReportOptions o = small_report();
+  o.scenes = {"lamps"};
+  o.divisors = {1};
+  const VolumeReport r = run_volume_report(*runtime(), o);
+  ASSERT_EQ(r.rows.size(), 2u) << "8 and 64 steps, full resolution, physical only";
+  const VolumeReportRow* coarse = find(r, "lamps", VolumeIntegrator::physical, 8, 1);
+  const VolumeReportRow* fine = find(r, "lamps", VolumeIntegrator::physical, 64, 1);
+  ASSERT_TRUE(coarse && fine);
+  std::printf("  lamps, full resolution: max error %.3g (8 steps) -> %.3g (64 steps), p99.9 %.3g -> %.3g\n",
+              coarse->max_abs_err, fine->max_abs_err, coarse->p999_abs_err, fine->p999_abs_err);
+  EXPECT_EQ(coarse->nonfinite + fine->nonfinite, 0u);
+  EXPECT_GT(coarse->max_abs_err, 0.0);
+  EXPECT_LT(fine->max_abs_err, 0.5 * coarse->max_abs_err);
+  EXPECT_LT(fine->p999_abs_err, 0.5 * coarse->p999_abs_err);
 }
 
 TEST(VolumeReport, PhysicalErrorShrinksWithStepsOnTheDemo) {
@@ -161,6 +216,11 @@ TEST(VolumeReportOptionsCheck, BadOptionsNameTheValueAndTheRule) {
       {[](VolumeReportOptions& o) { o.steps = {0}; }, "steps must be in [1, 4096] (got 0)"},
       {[](VolumeReportOptions& o) { o.divisors = {3}; }, "divisor must be 1, 2 or 4 (got 3)"},
       {[](VolumeReportOptions& o) { o.scenes = {"fog"}; }, "scene 'fog' is not one of"},
+      {[](VolumeReportOptions& o) {
+         o.scenes = {"shafts"};
+         o.integrators = {VolumeIntegrator::stylized};
+       },
+       "scene 'shafts' marches the height fog, which needs the physical integrator"},
       {[](VolumeReportOptions& o) { o.width = 0; }, "frame size must be >= 1x1 (got 0x90)"},
       {[](VolumeReportOptions& o) { o.noise = {NoiseSampling::automatic}; },
        "noise sampling must be buffer or image (got auto)"},
@@ -246,6 +306,36 @@ TEST(VolumeErrorBudget, PicksTheFastestMeetingTheBudgetAndReadsItsCache) {
   EXPECT_EQ(volume_budget_measurements(), before + 1);
 }
 
+// With the marched height fog the budget is measured apart (its own cache), over the light-shaft
+// scene too: its worst error is at least the volume scenes' own.
+TEST(VolumeErrorBudget, TheMarchedHeightFogIsMeasuredWithTheShaftScene) {
+  FOGCL_REQUIRE_DEVICE();
+  const VolumeBudgetOptions o = small_budget(fresh_dir("volume-budget-height"));
+  VolumeSettings volumes_only;
+  volumes_only.integrator = VolumeIntegrator::physical;
+  VolumeSettings height = volumes_only;
+  height.height_fog = demo_shaft_fog();
+  const std::size_t before = volume_budget_measurements();
+  const VolumeQualityChoice a = choose_volume_quality(*runtime(), volumes_only, ColorFormat::rgba32f, 1e9, o);
+  const VolumeQualityChoice b = choose_volume_quality(*runtime(), height, ColorFormat::rgba32f, 1e9, o);
+  EXPECT_EQ(volume_budget_measurements(), before + 2) << "two measurements: the height fog's is its own";
+  EXPECT_NE(a.cache_file, b.cache_file);
+  EXPECT_TRUE(b.settings.height_fog.has_value()) << "the caller's settings come back with the choice";
+  std::ifstream cache(b.cache_file);
+  const std::string text((std::istreambuf_iterator<char>(cache)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("integrator,physical+height-fog"), std::string::npos) << text;
+  ASSERT_EQ(a.candidates.size(), b.candidates.size());
+  for (const VolumeVariantMeasurement& m : b.candidates)
+    for (const VolumeVariantMeasurement& n : a.candidates)
+      if (m.steps == n.steps && m.divisor == n.divisor && m.upsampling == n.upsampling) {
+        std::printf("[ vbudget  ] %-28s worst error %.3g with the marched fog, %.3g without\n",
+                    volume_quality_name(m.steps, m.divisor, m.upsampling, m.noise).c_str(), m.max_abs_err,
+                    n.max_abs_err);
+        EXPECT_GE(m.max_abs_err, n.max_abs_err) << "the worst over more scenes";
+      }
+  EXPECT_NE(b.reason.find("with the marched height fog"), std::string::npos) << b.reason;
+}
+
 // fogcl apply --volumes --max-error: reads the cache the API wrote, prints the choice, runs it.
 TEST(VolumeErrorBudgetCli, MaxErrorPicksTheVariantAndExplicitFlagsConflict) {
   FOGCL_REQUIRE_DEVICE();
@@ -297,6 +387,40 @@ TEST(VolumeErrorBudgetCli, MaxErrorPicksTheVariantAndExplicitFlagsConflict) {
   EXPECT_FALSE(fs::exists(dir + "/tiny.exr"));
 }
 
+// fogcl apply --mode height --height-volumetric --max-error, without --volumes: the budget picks the
+// march's variant from the marched fog's own measurement (here the cache the API wrote).
+TEST(VolumeErrorBudgetCli, MaxErrorPicksTheMarchedHeightFogsVariant) {
+  FOGCL_REQUIRE_DEVICE();
+  const std::string dir = fresh_dir("volume-budget-height-cli");
+  const DemoFrame frame = render_demo_scene(48, 27);
+  write_exr_rgba(dir + "/scene.exr", frame.color);
+  write_exr_depth(dir + "/scene-depth.exr", frame.depth);
+  VolumeSettings base;
+  base.integrator = VolumeIntegrator::physical;
+  base.height_fog = demo_shaft_fog();
+  const ColorFormat storage = read_exr_color(dir + "/scene.exr").format();
+  const VolumeQualityChoice measured =
+      choose_volume_quality(*runtime(), base, storage, 1e9, small_budget(dir + "/xdg/fogcl"));
+  const DemoView view;
+  const glm::vec3 fwd = view.target - view.eye;
+  char pose[256];
+  std::snprintf(pose, sizeof pose, " --eye %.9g,%.9g,%.9g --forward %.9g,%.9g,%.9g --up 0,1,0", view.eye.x, view.eye.y,
+                view.eye.z, fwd.x, fwd.y, fwd.z);
+  const std::string cmd = "apply --color " + dir + "/scene.exr --depth " + dir +
+                          "/scene-depth.exr --near 0.3 --far 1000 --fov 60 --mode height --density 0.05 "
+                          "--height-falloff 0.3 --height-volumetric --verbose --max-error 1e9" +
+                          pose + " --device " + cli_device() + " --out " + dir + "/out.exr";
+  const CliRun r = run_cli(cmd, "XDG_CACHE_HOME='" + dir + "/xdg'");
+  std::printf("%s", r.output.c_str());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("measurement read from the cache"), std::string::npos) << r.output;
+  const std::string chosen = volume_quality_name(measured.chosen.steps, measured.chosen.divisor,
+                                                 measured.chosen.upsampling, measured.chosen.noise);
+  EXPECT_NE(r.output.find("volumes: " + chosen + " is the fastest variant"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("with the marched height fog"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir + "/out.exr"));
+}
+
 // fogcl report's volumetric flags: bad values and misplaced flags are one line, exit 1, before
 // any measurement.
 TEST(VolumeReportCli, BadFlagsAreOneLineErrors) {
@@ -308,7 +432,7 @@ TEST(VolumeReportCli, BadFlagsAreOneLineErrors) {
       {"--volumetric --integrators riemann", "--integrators must be one of stylized or physical (got 'riemann')"},
       {"--volumetric --runs 2 --device " + cli_device(), "--runs must be >= 3 with --volumetric (got 2)"},
       {"--volumetric --scenes fog,dense --device " + cli_device(),
-       "--scenes must be one of demo, dense, thin or inside (got 'fog') in 'fog,dense'"},
+       "--scenes must be one of demo, dense, thin, inside, shafts or lamps (got 'fog') in 'fog,dense'"},
       {"--steps 8", "--steps selects volumetric variants; it needs --volumetric"},
       {"--runs 5", "--runs must be >= 7 for the deferred report (got 5)"},
   };

@@ -204,6 +204,8 @@ void resolve_apply_flags(const CLI::App& apply, ApplyFlags& flags) {
                                        "--sensor-width", "--sensor-height"}) +
                     (ap.infinite_far ? ", --infinite-far" : "");
   resolve_height_flags(apply, ap);
+  // --height-volumetric runs the volumetric pass without --volumes: the budget is its too.
+  ap.volumes.max_error_given = ap.max_error_given && (!ap.volumes.volumes_path.empty() || ap.volumes.height_fog);
 }
 
 std::string parse_error_text(const CLI::ParseError& e, const std::vector<const CLI::App*>& commands, bool* rule) {

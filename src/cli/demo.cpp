@@ -143,6 +143,8 @@ int run_demo(const DemoOptions& o) {
       set_memory_stage("running the demo's volumetric rows");
       run_demo_volumes(o, backends, d.settings);
     }
+  set_memory_stage("running the demo's light-shaft rows");
+  run_demo_shafts(o, backends);
   std::printf("\nwrote EXR and PNG images to %s/\n", o.out_dir.c_str());
   return 0;
 }

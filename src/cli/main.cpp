@@ -13,6 +13,7 @@
 #include "cli/frame_memory.h"
 #include "cli/flag_values.h"
 #include "cli/number_list.h"
+#include "fogcl/volume_report.h"
 #include "cli/sequence.h"
 #include "cli/usage.h"
 #include "cli/version_info.h"
@@ -71,7 +72,7 @@ int main(int argc, char** argv) {
 
   fogcl::cli::ReportCliOptions report;
   std::string steps_text, scenes_text, integrators_text;
-  const std::vector<std::string> kScenes{"demo", "dense", "thin", "inside"}, kIntegrators{"stylized", "physical"};
+  const std::vector<std::string> kScenes = fogcl::volume_report_scene_names(), kIntegrators{"stylized", "physical"};
   CLI::App* report_cmd = app.add_subcommand(
       "report",
       "Error against run time: every precision variant x color storage (and the scalar path) on a set of "
@@ -86,12 +87,13 @@ int main(int argc, char** argv) {
       ->check(integer_in(1, 1000, "in [1, 1000] (>= 7 for the deferred report, >= 3 with --volumetric)"));
   report_cmd->add_flag("--volumetric", report.volumetric,
                        "The volumetric pass instead: steps x resolution x upsampling x noise sampling x integrator x "
-                       "storage on four volume scenes against the scalar<double> march at 4096 steps (default frame "
+                       "storage on four volume scenes, a light-shaft and a street-lamp scene against the scalar<double> march at 4096 "
+                       "steps (default frame "
                        "160x90); writes volume-report.csv, .json and .png");
   report_cmd->add_option("--steps", steps_text, "--volumetric: only these step counts, each in [1, 4096], e.g. 16,32 "
                                                 "(default all six)")
       ->check(fogcl::cli::value_check([](const std::string& text) { fogcl::cli::parse_step_list("--steps", text); }));
-  report_cmd->add_option("--scenes", scenes_text, "--volumetric: only these of demo,dense,thin,inside")
+  report_cmd->add_option("--scenes", scenes_text, "--volumetric: only these of demo,dense,thin,inside,shafts,lamps")
       ->check(fogcl::cli::value_check(
           [&kScenes](const std::string& text) { fogcl::cli::keyword_list_value("--scenes", text, kScenes); }));
   report_cmd->add_option("--integrators", integrators_text, "--volumetric: only these of stylized,physical")

@@ -281,6 +281,15 @@ std::unique_ptr<VolumeStage> VolumeStage::create(const VolumeCliOptions& o, cons
     }
     s.shadow_ = read_shadow_map(o.shadow_map_path, m, o.shadow_reversed_z, o.max_memory);
   }
+  if (o.height_fog && o.volumes_path.empty()) {
+    // Only the marched fog is lit, by its sun lobe: these flags would change nothing in the image.
+    if (given(o, "--light-color"))
+      throw Error("--light-color colors the fog volumes' light (--volumes); the marched height fog's sun is "
+                  "--sun-color");
+    if (map && !o.height_fog->height.sun)
+      throw Error("--shadow-map with --height-volumetric needs --sun-color (the sun's in-scattering that the map "
+                  "shadows) or --volumes");
+  }
 
   if (o.max_error_given) {
     // The budget picks these four; a flag that names one too is a contradiction, not a hint.
@@ -368,8 +377,9 @@ void VolumeStage::apply_frame(const In& in, const Depth& depth, Out& out, const 
     chosen_storage_ = in.format();
     char buf[320];
     std::snprintf(buf, sizeof buf,
-                  "volumetric error budget: --max-error %g, %s integrator, %s storage; measurement %s (%s)\n",
-                  options_.max_error, to_string(settings_.integrator), to_string(in.format()),
+                  "volumetric error budget: --max-error %g, %s integrator%s, %s storage; measurement %s (%s)\n",
+                  options_.max_error, to_string(settings_.integrator),
+                  settings_.height_fog ? " with the marched height fog" : "", to_string(in.format()),
                   c.from_cache ? "read from the cache" : "taken now and cached", c.measured_on.c_str());
     budget_why_ = buf;
     budget_why_ += "  cache: " + c.cache_file + "\n";
@@ -397,7 +407,7 @@ void VolumeStage::apply_frame(const In& in, const Depth& depth, Out& out, const 
   } catch (const ClError&) {
     throw;  // the device's
   } catch (const Error& e) {
-    throw Error(options_.volumes_path + ": " + e.what());  // what the volumes make in this frame (how many are visible)
+    throw Error(options_.volumes_path.empty() ? std::string(e.what()) : options_.volumes_path + ": " + e.what());  // what the volumes make in this frame (how many are visible)
   }
   if (!verbose) return;
   std::fprintf(stderr, "%s", budget_why_.c_str());
@@ -405,8 +415,9 @@ void VolumeStage::apply_frame(const In& in, const Depth& depth, Out& out, const 
   const int s = settings_.resolution_divisor;
   std::fprintf(
       stderr,
-      "volumes: %zu of %zu visible (%s), %s integrator, %d steps, %s resolution (%dx%d target), %s upsampling\n",
-      visible, scene.volumes.size(), options_.volumes_path.c_str(), to_string(settings_.integrator), settings_.steps,
+      "volumes: %zu of %zu visible (%s)%s, %s integrator, %d steps, %s resolution (%dx%d target), %s upsampling\n",
+      visible, scene.volumes.size(), options_.volumes_path.empty() ? "no --volumes" : options_.volumes_path.c_str(),
+      settings_.height_fog ? " and the marched height fog" : "", to_string(settings_.integrator), settings_.steps,
       resolution_name(s), (in.width() + s - 1) / s, (in.height() + s - 1) / s, to_string(settings_.upsampling));
   std::fprintf(stderr, "  camera pose (fogcl's world): %s, from %s\n", pose_text(scene.pose).c_str(),
                pose_from_.c_str());

@@ -130,5 +130,7 @@ struct DemoOptions;
 class Backend;
 void run_demo_volumes(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>& backends,
                       const FogSettings& deferred);
+// `fogcl demo`'s light-shaft rows (cli/demo_shafts.cpp): the marched height fog under a low sun.
+void run_demo_shafts(const DemoOptions& o, std::vector<std::unique_ptr<Backend>>& backends);  // and street lamps
 
 }  // namespace fogcl::cli

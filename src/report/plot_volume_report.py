@@ -103,6 +103,8 @@ if len(panels) < nrows * cols:
             ax.plot([p[0] for p in front], [p[1] for p in front], color=FRONT[integrator], lw=0.9, ls="--", zorder=0)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    # The marched fog's scenes (physical rows only) are in it when the report ran them: then the
+    # physical points are --height-volumetric's budget.
     ax.set_title("what --max-error sees: worst over the scenes (rgba32f)", fontsize=10)
     ax.set_xlabel("device time, sum over the scenes [ms]")
     ax.set_ylabel("worst max |color - float64|")

@@ -1,6 +1,7 @@
 // The volumetric error budget: the fastest quality variant (steps, resolution,
 // upsampling, noise sampling) whose measured worst color error on the volume report's scenes meets
-// a maximum, measured once per (device, driver, library version + kernel digest, integrator, storage) and cached as
+// a maximum, measured once per (device, driver, library version + kernel digest, integrator, marched height
+// fog or not, storage) and cached as
 // a small CSV file under $XDG_CACHE_HOME/fogcl, like the deferred pass's (budget.cpp).
 #include <algorithm>
 #include <atomic>
@@ -40,12 +41,18 @@ bool parse_number(const std::string& s, double* v) {
 }
 
 // Metadata lines "key,value" the cache must match to be trusted.
-std::map<std::string, std::string> cache_meta(const report_detail::DeviceKey& key, VolumeIntegrator integrator,
+// What the measurement covers: the integrator, and whether the pass marches the height fog (then
+// the light-shaft scene is measured with the volume scenes).
+std::string measured_kind(const VolumeSettings& base) {
+  return std::string(to_string(base.integrator)) + (base.height_fog ? "+height-fog" : "");
+}
+
+std::map<std::string, std::string> cache_meta(const report_detail::DeviceKey& key, const VolumeSettings& base,
                                               ColorFormat storage) {
   return {{"device", one_line(key.device)},
           {"driver", one_line(key.driver)},
           {"version", key.version},
-          {"integrator", to_string(integrator)},
+          {"integrator", measured_kind(base)},
           {"storage", to_string(storage)}};
 }
 
@@ -88,13 +95,17 @@ void write_cache(const std::string& path, const std::map<std::string, std::strin
   report_detail::write_cache_file(path, s.str());
 }
 
-Cached measure(const Runtime& runtime, VolumeIntegrator integrator, ColorFormat storage,
+Cached measure(const Runtime& runtime, const VolumeSettings& base, ColorFormat storage,
                const VolumeReportOptions& options) {
   VolumeReportOptions o = options;
-  o.integrators = {integrator};
+  o.integrators = {base.integrator};
   o.storages = {storage};
   o.riemann = false;
   o.scenes.clear();
+  // Every scene when the pass marches the height fog (the worst of the volumes and the shafts);
+  // without it, the volume scenes only.
+  for (const std::string& scene : volume_report_scene_names())
+    if (base.height_fog || !volume_report_scene_marches_height_fog(scene)) o.scenes.push_back(scene);
   const VolumeReport report = run_volume_report(runtime, o);
   ++g_measurements;
   Cached c;
@@ -132,19 +143,19 @@ VolumeQualityChoice choose_volume_quality(const Runtime& runtime, const VolumeSe
   if (base.integrator == VolumeIntegrator::riemann)
     throw Error("the volumetric error budget measures the stylized and physical integrators, not riemann");
   const report_detail::DeviceKey key = report_detail::device_key(runtime);
-  const auto meta = cache_meta(key, base.integrator, storage);
+  const auto meta = cache_meta(key, base, storage);
   VolumeQualityChoice choice;
   choice.max_error = max_error;
   const std::string dir = options.cache_dir.empty() ? report_detail::default_cache_dir() : options.cache_dir;
   choice.cache_file =
       (fs::path(dir) / report_detail::cache_file_name(
-                           "volume-budget", key, std::string(to_string(base.integrator)) + "/" + to_string(storage)))
+                           "volume-budget", key, measured_kind(base) + "/" + to_string(storage)))
           .string();
   Cached cached;
   if (read_cache(choice.cache_file, meta, &cached)) {
     choice.from_cache = true;
   } else {
-    cached = measure(runtime, base.integrator, storage, options.measure);
+    cached = measure(runtime, base, storage, options.measure);
     try {
       write_cache(choice.cache_file, meta, cached);
     } catch (const std::exception& e) {  // a read-only cache folder costs a re-measure, no more
@@ -169,13 +180,15 @@ VolumeQualityChoice choose_volume_quality(const Runtime& runtime, const VolumeSe
       choice.reason = volume_quality_name(m.steps, m.divisor, m.upsampling, m.noise) + " is the fastest variant (" +
                       short_num(m.time_ms) + " ms over the report's scenes) whose worst color error " +
                       short_num(m.max_abs_err) + " is <= the budget " + short_num(max_error) + " (" +
-                      to_string(base.integrator) + ", " + to_string(storage) + ")";
+                      to_string(base.integrator) + (base.height_fog ? " with the marched height fog" : "") + ", " +
+                      to_string(storage) + ")";
       return choice;
     }
   }
   if (best == nullptr) throw Error("volumetric error budget: the measurement has no variant");
   throw Error("no volumetric variant meets the error budget (max error " + short_num(max_error) + ") with the " +
-              to_string(base.integrator) + " integrator and " + to_string(storage) + " storage on " + key.device +
+              to_string(base.integrator) + " integrator" + (base.height_fog ? ", the marched height fog" : "") +
+              " and " + to_string(storage) + " storage on " + key.device +
               ": the best achievable worst color error is " + short_num(best->max_abs_err) + " (" +
               volume_quality_name(best->steps, best->divisor, best->upsampling, best->noise) + ")");
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <future>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -48,9 +49,16 @@ void physical_light(FogVolume& v) {  // as demo_fog_volumes() lights its physica
   v.anisotropy = 0.2f;
 }
 
+std::string scene_list() {
+  std::string names;
+  for (const std::string& n : volume_report_scene_names()) names += (names.empty() ? "" : ", ") + n;
+  return names;
+}
+
 // The volumes of a scene for an integrator (riemann: the physical volumes).
 std::vector<FogVolume> scene_volumes(const std::string& name, VolumeIntegrator integrator) {
   const bool physical = integrator != VolumeIntegrator::stylized;
+  if (volume_report_scene_marches_height_fog(name)) return {};  // the fog alone: its shafts' error
   if (name == "demo") return demo_fog_volumes(physical ? VolumeIntegrator::physical : VolumeIntegrator::stylized);
   // dense and thin: a sphere of diameter 5 in front of the camera, dipping into the ground (rays
   // that end on the ground inside it have shorter chords).
@@ -76,7 +84,7 @@ std::vector<FogVolume> scene_volumes(const std::string& name, VolumeIntegrator i
     v.fog_cutoff = 0.3f;
     v.density = physical ? 0.25f : 1.5f;
   } else {
-    throw Error("volume report scene '" + name + "' is not one of demo, dense, thin, inside");
+    throw Error("volume report scene '" + name + "' is not one of " + scene_list());
   }
   if (physical) physical_light(v);
   return {v};
@@ -92,7 +100,7 @@ struct DeviceResult {
 // then `runs` timed frames; `out` holds the last.
 DeviceResult device_run(const Runtime& rt, VolumePass& pass, const ColorImage& in, const DepthImage& depth,
                         const CameraParams& params, const VolumeScene& scene, const VolumeSettings& settings,
-                        float max_eye, int runs) {
+                        const ShadowMap* shadow, float max_eye, int runs) {
   return with_cl_errors([&] {
     DeviceResult r;
     r.out = ColorImage(in.width(), in.height(), in.format());
@@ -110,13 +118,21 @@ DeviceResult device_run(const Runtime& rt, VolumePass& pass, const ColorImage& i
     fb.color_in = color_in();
     fb.depth = depth_buffer();
     fb.color_out = color_out();
-    pass.prepare(params, scene, settings, in.format());
-    adopt(pass.enqueue(rt.queue(), fb, params, scene, settings, nullptr, {}, max_eye)).wait();
+    cl::Buffer shadow_depth;
+    ShadowMapBuffer sm;
+    if (shadow != nullptr) {
+      shadow_depth = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, shadow->depth.size_bytes(),
+                                const_cast<float*>(shadow->depth.data()));
+      sm = {shadow_depth(), shadow->depth.width(), shadow->depth.height(), shadow->params};
+    }
+    const ShadowMapBuffer* smp = shadow != nullptr ? &sm : nullptr;
+    pass.prepare(params, scene, settings, in.format(), shadow != nullptr ? &shadow->params : nullptr);
+    adopt(pass.enqueue(rt.queue(), fb, params, scene, settings, smp, {}, max_eye)).wait();
     std::vector<double> ms;
     for (int i = 0; i < runs; ++i) {
       cl::Event before;
       queue.enqueueMarkerWithWaitList(nullptr, &before);
-      const cl::Event done = adopt(pass.enqueue(rt.queue(), fb, params, scene, settings, nullptr, {}, max_eye));
+      const cl::Event done = adopt(pass.enqueue(rt.queue(), fb, params, scene, settings, smp, {}, max_eye));
       done.wait();
       ms.push_back(double(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
                           before.getProfilingInfo<CL_PROFILING_COMMAND_END>()) *
@@ -131,6 +147,41 @@ DeviceResult device_run(const Runtime& rt, VolumePass& pass, const ColorImage& i
     r.time_ms = report_detail::median(ms);
     return r;
   });
+}
+
+// A scene's frame, camera and light, and what the pass takes besides the volumes: the demo's view;
+// the volume scenes under the demo's light, the light-shaft scene under its low sun ahead, with
+// its shadow map and its marched fog, the lamps' scene at night with its street lamps and mist
+// (fogcl/demo_scene.h).
+struct SceneSetup {
+  DemoFrame frame;
+  float max_eye = 0;
+  VolumeScene base;  // pose and light; the volumes come per integrator
+  std::optional<ShadowMap> shadow;
+  std::optional<FogSettings> height_fog;
+};
+
+SceneSetup scene_setup(const std::string& name, int width, int height) {
+  SceneSetup s;
+  const DemoView view;
+  const bool shafts = name == "shafts", lamps = name == "lamps";
+  MainLight light = shafts ? demo_low_sun() : demo_light();
+  s.frame = lamps ? demo_night_frame(width, height)
+                  : render_demo_scene(width, height, PerspectiveCamera{}, view, ColorFormat::rgba32f,
+                                      shafts ? std::optional<glm::vec3>(light.direction) : std::nullopt);
+  if (lamps) {
+    light.color = glm::vec3(0.0f);  // night: the lamps and the mist's ambient light it
+    s.base.lights = demo_street_lamps();
+    s.height_fog = demo_night_fog();
+  }
+  s.max_eye = max_eye_depth(s.frame.depth, s.frame.params);
+  s.base.pose = CameraPose{view.eye, view.target - view.eye, glm::vec3(0.0f, 1.0f, 0.0f)};
+  s.base.light = light;
+  if (shafts) {
+    s.shadow = render_demo_shadow_map(1024, 1024, DemoShadowRegion{}, light.direction);
+    s.height_fog = demo_shaft_fog();
+  }
+  return s;
 }
 
 // The reference composited over `in` (the same frame in another storage): the reference march is
@@ -169,9 +220,15 @@ void validate(const VolumeReportOptions& o) {
     if (i == VolumeIntegrator::riemann)
       throw Error("volume report integrators are stylized and physical; the Riemann rows come with options.riemann");
   const std::vector<std::string> names = volume_report_scene_names();
-  for (const std::string& s : o.scenes)
+  const bool physical =
+      std::find(o.integrators.begin(), o.integrators.end(), VolumeIntegrator::physical) != o.integrators.end();
+  for (const std::string& s : o.scenes) {
     if (std::find(names.begin(), names.end(), s) == names.end())
-      throw Error("volume report scene '" + s + "' is not one of demo, dense, thin, inside");
+      throw Error("volume report scene '" + s + "' is not one of " + scene_list());
+    if (volume_report_scene_marches_height_fog(s) && !physical)
+      throw Error("volume report scene '" + s +
+                  "' marches the height fog, which needs the physical integrator (add physical to the integrators)");
+  }
   for (NoiseSampling n : o.noise)  // rows name what ran: the device's choice is one of these two
     if (n != NoiseSampling::buffer && n != NoiseSampling::image)
       throw Error(std::string("volume report noise sampling must be buffer or image (got ") + to_string(n) + ")");
@@ -179,7 +236,11 @@ void validate(const VolumeReportOptions& o) {
     throw Error("volume report needs at least one step count, resolution, integrator, storage and noise sampling");
 }
 
-std::vector<std::string> volume_report_scene_names() { return {"demo", "dense", "thin", "inside"}; }
+std::vector<std::string> volume_report_scene_names() {
+  return {"demo", "dense", "thin", "inside", "shafts", "lamps"};
+}
+
+bool volume_report_scene_marches_height_fog(const std::string& scene) { return scene == "shafts" || scene == "lamps"; }
 
 std::string volume_quality_name(int steps, int divisor, VolumeUpsampling upsampling, NoiseSampling noise) {
   std::string s = "s" + std::to_string(steps) + " " + resolution_name(divisor);
@@ -203,18 +264,18 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
   report.device = runtime.description();
   report.driver = with_cl_errors([&] { return wrap(runtime.device()).getInfo<CL_DRIVER_VERSION>(); });
 
-  const DemoView view;
-  const DemoFrame frame = render_demo_scene(o.width, o.height, PerspectiveCamera{}, view);
-  const float max_eye = max_eye_depth(frame.depth, frame.params);
-  VolumeScene base;
-  base.pose = CameraPose{view.eye, view.target - view.eye, glm::vec3(0.0f, 1.0f, 0.0f)};
-  base.light = demo_light();
   const std::vector<std::string> scenes = o.scenes.empty() ? volume_report_scene_names() : o.scenes;
+  std::map<std::string, SceneSetup> setups;
+  for (const std::string& name : scenes) setups.emplace(name, scene_setup(name, o.width, o.height));
   std::vector<VolumeIntegrator> integrators = o.integrators;
   const bool riemann_rows = o.riemann && std::find(scenes.begin(), scenes.end(), "dense") != scenes.end();
   if (riemann_rows &&
       std::find(integrators.begin(), integrators.end(), VolumeIntegrator::physical) == integrators.end())
     integrators.push_back(VolumeIntegrator::physical);  // the Riemann rows' reference
+  // The marched height fog has the physical integrator only.
+  const auto runs_with = [](const std::string& scene, VolumeIntegrator i) {
+    return !volume_report_scene_marches_height_fog(scene) || i == VolumeIntegrator::physical;
+  };
 
   struct Job {
     std::string scene;
@@ -224,7 +285,8 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
   std::vector<Job> jobs;
   for (const std::string& scene : scenes) {
     for (VolumeIntegrator integrator : o.integrators)
-      for (ColorFormat storage : o.storages)
+      for (ColorFormat storage : o.storages) {
+        if (!runs_with(scene, integrator)) continue;
         for (int steps : o.steps)
           for (int divisor : o.divisors)
             for (VolumeUpsampling up : {VolumeUpsampling::depth_aware, VolumeUpsampling::bilinear}) {
@@ -237,9 +299,11 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
                 s.resolution_divisor = divisor;
                 s.upsampling = up;
                 s.noise_sampling = noise;
+                s.height_fog = setups.at(scene).height_fog;
                 jobs.push_back({scene, s, storage});
               }
             }
+      }
     if (scene == "dense" && riemann_rows)
       for (int steps : o.steps) {
         VolumeSettings s;
@@ -260,20 +324,24 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<std::pair<std::string, VolumeIntegrator>> refs_to_do;
     for (const std::string& s : scenes)
-      for (VolumeIntegrator i : integrators) refs_to_do.emplace_back(s, i);
+      for (VolumeIntegrator i : integrators)
+        if (runs_with(s, i)) refs_to_do.emplace_back(s, i);
     const std::size_t threads = std::max(1u, std::thread::hardware_concurrency());
     for (std::size_t at = 0; at < refs_to_do.size(); at += threads) {
       std::vector<std::future<VolumeResult<double>>> running;
       for (std::size_t j = at; j < std::min(refs_to_do.size(), at + threads); ++j)
         running.push_back(std::async(std::launch::async, [&, j] {
-          VolumeScene scene = base;
+          const SceneSetup& setup = setups.at(refs_to_do[j].first);
+          VolumeScene scene = setup.base;
           scene.volumes = scene_volumes(refs_to_do[j].first, refs_to_do[j].second);
           VolumeSettings s;
           s.integrator = refs_to_do[j].second;
           s.steps = o.reference_steps;
           s.resolution_divisor = 1;
           s.jitter = false;
-          return volumes_scalar<double>(frame.color, frame.depth, frame.params, scene, s);
+          s.height_fog = setup.height_fog;
+          return volumes_scalar<double>(setup.frame.color, setup.frame.depth, setup.frame.params, scene, s,
+                                        setup.shadow ? &*setup.shadow : nullptr);
         }));
       for (std::size_t j = at; j < std::min(refs_to_do.size(), at + threads); ++j)
         refs.emplace(std::make_pair(refs_to_do[j].first, int(refs_to_do[j].second)), running[j - at].get());
@@ -287,7 +355,9 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
   for (std::size_t n = 0; n < jobs.size(); ++n) {
     const Job& job = jobs[n];
     const VolumeSettings& s = job.settings;
-    VolumeScene scene = base;
+    const SceneSetup& setup = setups.at(job.scene);
+    const DemoFrame& frame = setup.frame;
+    VolumeScene scene = setup.base;
     scene.volumes = scene_volumes(job.scene, s.integrator);
     auto in_it = inputs.find({job.scene, int(job.storage)});
     if (in_it == inputs.end())
@@ -300,7 +370,8 @@ VolumeReport run_volume_report(const Runtime& runtime, const VolumeReportOptions
     if (ref_it == ref_rgba.end())
       ref_it = ref_rgba.emplace(ref_key, recomposite(refs.at({job.scene, int(truth)}), in)).first;
 
-    const DeviceResult r = device_run(runtime, pass, in, frame.depth, frame.params, scene, s, max_eye, o.runs);
+    const DeviceResult r = device_run(runtime, pass, in, frame.depth, frame.params, scene, s,
+                                      setup.shadow ? &*setup.shadow : nullptr, setup.max_eye, o.runs);
     const report_detail::ColorErrorStats e = report_detail::color_error_stats(r.out, in, ref_it->second, job.storage);
     VolumeReportRow row;
     row.scene = job.scene;

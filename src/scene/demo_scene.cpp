@@ -86,6 +86,19 @@ bool in_shadow(V3 p, V3 to_light) {
 // The light, as the shading below and the shadow map use it.
 const V3 kToLight{0.35, 0.80, -0.50};
 
+// The scene's default sun, or the caller's direction (checked: finite, not vertical, as the
+// shadow map's light camera needs a horizontal right axis).
+V3 sun_direction(const std::optional<glm::vec3>& to_light) {
+  if (!to_light) return normalize(kToLight);
+  const V3 d = to_v3(*to_light);
+  const double len = length(d);
+  if (!(std::isfinite(len) && len > 0.0))
+    throw Error("demo sun direction must be finite and non-zero");
+  const V3 u = d * (1.0 / len);
+  if (!(std::fabs(u.y) < 0.999)) throw Error("demo sun direction must not be vertical (|y| / length >= 0.999)");
+  return u;
+}
+
 V3 sky(V3 dir_unit) {
   const double s = std::sqrt(std::clamp(dir_unit.y, 0.0, 1.0));
   return kSkyHorizon * (1.0 - s) + kSkyZenith * s;
@@ -94,7 +107,7 @@ V3 sky(V3 dir_unit) {
 }  // namespace
 
 DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera,
-                            const DemoView& view, ColorFormat format) {
+                            const DemoView& view, ColorFormat format, const std::optional<glm::vec3>& to_light_dir) {
   if (width < 1 || height < 1)
     throw Error("demo scene size must be at least 1x1 (got " + std::to_string(width) + "x" +
                 std::to_string(height) + ")");
@@ -139,7 +152,7 @@ DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera,
   }
   if (!eye_outside) throw Error("demo view eye must lie outside the scene's spheres");
 
-  const V3 to_light = normalize(kToLight);
+  const V3 to_light = sun_direction(to_light_dir);
 
   float* const rgba32 = format == ColorFormat::rgba32f ? frame.color.rgba32f() : nullptr;
   for (int y = 0; y < height; ++y) {
@@ -220,21 +233,24 @@ DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera,
   return frame;
 }
 
-MainLight demo_light() {
+MainLight demo_light(const std::optional<glm::vec3>& to_light_dir) {
   MainLight light;
-  const V3 d = normalize(kToLight);
+  const V3 d = sun_direction(to_light_dir);
   light.direction = glm::vec3(float(d.x), float(d.y), float(d.z));
   light.color = glm::vec3(float(kSunColor.x), float(kSunColor.y), float(kSunColor.z));
   return light;
 }
 
-ShadowMap render_demo_shadow_map(int width, int height, const DemoShadowRegion& region) {
+MainLight demo_low_sun() { return demo_light(glm::vec3(-0.3f, 0.15f, 1.0f)); }
+
+ShadowMap render_demo_shadow_map(int width, int height, const DemoShadowRegion& region,
+                                 const std::optional<glm::vec3>& to_light_dir) {
   if (width < 1 || height < 1)
     throw Error("demo shadow map size must be at least 1x1 (got " + std::to_string(width) + "x" +
                 std::to_string(height) + ")");
   // Light camera basis (left-handed, as a camera's): forward along the light's rays, right =
   // normalize(cross(+y, forward)), up = cross(forward, right). The light is never vertical here.
-  const V3 forward = normalize(kToLight) * -1.0;
+  const V3 forward = sun_direction(to_light_dir) * -1.0;
   const V3 right = normalize(cross(V3{0.0, 1.0, 0.0}, forward));
   const V3 up = cross(forward, right);
 

@@ -70,3 +70,93 @@ std::vector<FogVolume> demo_fog_volumes(VolumeIntegrator integrator) {
 }
 
 }  // namespace fogcl
+
+namespace fogcl {
+
+FogSettings demo_shaft_fog() {
+  // A ground haze a few units deep (thins by e per 1/0.3 units of height), thick enough that the
+  // spheres' shadows cut dark shafts out of the sun's glow. Values chosen by looking at the PNGs.
+  FogSettings f;
+  f.mode = FogMode::height;
+  f.color = glm::vec3(0.12f, 0.15f, 0.2f);
+  f.density = 0.06f;
+  f.height.falloff = 0.2f;
+  f.height.cutoff = 100.0f;
+  f.height.base_height = 0.0f;
+  f.fog_skybox = true;
+  SunLobe sun;
+  sun.direction = demo_low_sun().direction;
+  sun.color = glm::vec3(1.8f, 1.45f, 0.95f);
+  sun.exponent = 16.0f;
+  f.height.sun = sun;
+  return f;
+}
+
+}  // namespace fogcl
+
+namespace fogcl {
+
+std::vector<LocalLight> demo_street_lamps() {
+  // Three street lamps on 4.5-unit poles along the left of the view and one on the right, spots
+  // pointing down with a warm sodium-like color, and two small lanterns (point lights) near the
+  // ground. Values chosen by looking at the PNGs.
+  std::vector<LocalLight> lamps;
+  const auto street = [&](glm::vec3 at) {
+    LocalLight l;
+    l.kind = LightKind::spot;
+    l.position = at;
+    l.color = glm::vec3(1.0f, 0.72f, 0.4f);
+    l.intensity = 50.0f;
+    l.range = 14.0f;
+    l.radius = 0.15f;
+    l.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    l.inner_angle = 20.0f;
+    l.outer_angle = 38.0f;
+    lamps.push_back(l);
+  };
+  street(glm::vec3(-2.6f, 4.5f, 1.0f));
+  street(glm::vec3(-2.6f, 4.5f, 10.0f));
+  street(glm::vec3(-2.6f, 4.5f, 19.0f));
+  street(glm::vec3(4.0f, 4.5f, 6.0f));
+  const auto lantern = [&](glm::vec3 at, glm::vec3 color, float intensity) {
+    LocalLight l;
+    l.position = at;
+    l.color = color;
+    l.intensity = intensity;
+    l.range = 8.0f;
+    l.radius = 0.1f;
+    lamps.push_back(l);
+  };
+  lantern(glm::vec3(0.9f, 0.7f, 3.0f), glm::vec3(0.55f, 0.75f, 1.0f), 8.0f);
+  lantern(glm::vec3(1.5f, 1.0f, 14.0f), glm::vec3(1.0f, 0.45f, 0.25f), 20.0f);
+  return lamps;
+}
+
+FogSettings demo_night_fog() {
+  // A ground mist at night: the ambient (fog color) is a dim blue sky light, no sun lobe; the
+  // lamps' light is what glows in it.
+  FogSettings f;
+  f.mode = FogMode::height;
+  f.color = glm::vec3(0.015f, 0.02f, 0.035f);
+  f.density = 0.12f;
+  f.height.falloff = 0.25f;
+  f.height.cutoff = 60.0f;
+  f.fog_skybox = true;
+  return f;
+}
+
+}  // namespace fogcl
+
+namespace fogcl {
+
+DemoFrame demo_night_frame(int width, int height) {
+  DemoFrame frame = render_demo_scene(width, height);
+  for (int y = 0; y < frame.color.height(); ++y)
+    for (int x = 0; x < frame.color.width(); ++x) {
+      const glm::vec4 c = frame.color.pixel(x, y);
+      frame.color.set_pixel(x, y, glm::vec4(glm::vec3(c) * 0.04f, c.a));
+    }
+  return frame;
+}
+
+}  // namespace fogcl

@@ -20,11 +20,13 @@
 // or 0 (reversed Z).
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "fogcl/camera.h"
+#include "fogcl/fog_settings.h"
 #include "fogcl/image.h"
 #include "fogcl/volumes.h"
 
@@ -46,13 +48,22 @@ struct DemoView {
 };
 
 // Renders width x height pixels (>= 1 each, else fogcl::Error). camera.aspect is ignored and set to
-// float(width) / float(height); the camera is validated as make_camera_params does.
+// float(width) / float(height); the camera is validated as make_camera_params does. to_light: the
+// direction toward the sun that shades and shadows the scene (any length; finite, non-zero, not
+// vertical, else fogcl::Error); unset: demo_light()'s.
 DemoFrame render_demo_scene(int width, int height, PerspectiveCamera camera = {},
-                            const DemoView& view = {}, ColorFormat format = ColorFormat::rgba32f);
+                            const DemoView& view = {}, ColorFormat format = ColorFormat::rgba32f,
+                            const std::optional<glm::vec3>& to_light = std::nullopt);
 
 // The scene's directional light as the volumetric pass takes it: direction normalize(0.35, 0.8,
-// -0.5) (toward the light), color (1, 0.96, 0.9).
-MainLight demo_light();
+// -0.5) (toward the light, behind the default camera), color (1, 0.96, 0.9); with to_light, that
+// direction normalised (the rules of render_demo_scene's).
+MainLight demo_light(const std::optional<glm::vec3>& to_light = std::nullopt);
+
+// A low sun ahead of the default view (about 12 degrees up, a little left of the view direction;
+// demo_light's color): the light-shaft scenes' sun, which the spheres shadow toward the camera
+// (fogcl demo's height-shafts rows, the volume report's "shafts" scene).
+MainLight demo_low_sun();
 
 // The world region demo_shadow_map() covers: every sphere, the ground and the air up to y = 12
 // around the default view (x in [-25, 45], z in [-15, 65]).
@@ -67,8 +78,10 @@ struct DemoShadowRegion {
 // centre. Depth is float32 conventional Z in [0, 1] (0 at the light's near plane, linear in
 // distance along the light); a texel whose ray meets nothing before the far plane holds 1. The
 // params' world_to_light_clip follows ShadowMapParams: clip xy in [-1, 1] -> the map's uv (v = 0
-// at the bottom row), clip z / w (w = 1) the stored depth. width, height >= 1.
-ShadowMap render_demo_shadow_map(int width = 1024, int height = 1024, const DemoShadowRegion& region = {});
+// at the bottom row), clip z / w (w = 1) the stored depth. width, height >= 1. to_light: as
+// render_demo_scene's (unset: demo_light()'s direction).
+ShadowMap render_demo_shadow_map(int width = 1024, int height = 1024, const DemoShadowRegion& region = {},
+                                 const std::optional<glm::vec3>& to_light = std::nullopt);
 
 // The demo's four fog volumes, in this order: one around the default eye (the camera is inside),
 // one behind the (2.2, 1, -0.5) sphere, one crossing the ground, a wide bank around the far
@@ -76,5 +89,26 @@ ShadowMap render_demo_shadow_map(int width = 1024, int height = 1024, const Demo
 // fades of a few units. For the physical integrator the densities become sigma_t = 0.15 x the
 // stylized alpha scale, with a sky-coloured ambient and mild forward scattering (g = 0.2).
 std::vector<FogVolume> demo_fog_volumes(VolumeIntegrator integrator);
+
+// The light-shaft scenes' fog (fogcl demo's height-shafts rows, the volume report's "shafts"):
+// a height fog lying on the ground (FogMode::height, beta = 0.09 at y = 0, falloff 0.3, fogged
+// sky) with a sun lobe toward demo_low_sun(), marched with VolumeSettings::height_fog so the
+// render_demo_shadow_map(..., demo_low_sun().direction) map cuts shafts into it.
+FogSettings demo_shaft_fog();
+
+// Street lamps for the night scenes (fogcl demo's street-lamps rows, the volume report's "lamps"):
+// four spot lights on 4.5-unit poles pointing down (warm, intensity 50, range 14, cones 20-38
+// degrees), three along the left of the default view and one on the right, and two point-light
+// lanterns near the ground (cool blue and orange).
+std::vector<LocalLight> demo_street_lamps();
+
+// The night scenes' fog: a ground mist (FogMode::height, beta = 0.12 at y = 0, falloff 0.25,
+// fogged sky, cut off at 60 units) lit by a dim blue ambient and no sun lobe, marched with
+// VolumeSettings::height_fog so the lamps glow in it. The night frame is demo_night_frame()'s.
+FogSettings demo_night_fog();
+
+// The demo frame at night: render_demo_scene's colors times 0.04 (depth unchanged), so the fog's
+// lamps are what lights the view.
+DemoFrame demo_night_frame(int width, int height);
 
 }  // namespace fogcl

@@ -36,7 +36,7 @@ struct VolumeReportOptions {
 
 // One (scene, variant) measurement; errors against the reference over every pixel's R, G, B.
 struct VolumeReportRow {
-  std::string scene;    // "demo", "dense", "thin", "inside"
+  std::string scene;    // "demo", "dense", "thin", "inside", "shafts", "lamps"
   std::string variant;  // "physical-s64-half-depth-buffer-rgba32f", ...
   VolumeIntegrator integrator = VolumeIntegrator::stylized;
   int steps = 0;
@@ -61,8 +61,15 @@ struct VolumeReport {
 
 // "demo" (demo_fog_volumes(), the camera inside one of them), "dense" (one sphere, no noise,
 // sigma_t * diameter = 50), "thin" (one noisy sphere, sigma_t * diameter = 1e-4 at full noise),
-// "inside" (the camera inside one noisy volume). The demo scene's frame, camera and light.
+// "inside" (the camera inside one noisy volume): the demo scene's frame, camera and light.
+// "shafts": no volumes, the height fog marched (VolumeSettings::height_fog = demo_shaft_fog())
+// under demo_low_sun() with the scene's shadow map for that sun (1024x1024): light shafts; its
+// rows are the physical integrator's only (the marched fog's). "lamps": no volumes, the night
+// frame (demo_night_frame()) in a marched mist (demo_night_fog()) lit by demo_street_lamps()'s
+// spot and point lights; physical only too.
 std::vector<std::string> volume_report_scene_names();
+// true for the scenes whose rows march the height fog ("shafts", "lamps").
+bool volume_report_scene_marches_height_fog(const std::string& scene);
 
 // Throws fogcl::Error naming the value and the rule for bad options (all but what depends on the
 // device: image noise sampling needs image support).
