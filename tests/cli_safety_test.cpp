@@ -670,7 +670,7 @@ TEST_F(CliSafety, EachMisuseSaysWhatInOneLineWithItsExitCode) {
        "volume 0: unknown key 'ra\\u0000dius' (", 1},
       {"apply --color " + path("color.exr") + " --depth " + path("depth.exr") + kFog + " --volumes " +
            path("nul-top.json") + " --eye 0,1.6,-6 --forward 0,0,1 --up 0,1,0" + out,
-       "top level: unknown key 'vol\\u0000umes' (the only key is \"volumes\")", 1},
+       "top level: unknown key 'vol\\u0000umes' (the keys are \"volumes\" and \"lights\")", 1},
       // Usage errors: exit 2.
       {apply("--bogus" + out), "fogcl: error: unknown option '--bogus' for fogcl apply (see --help)", 2},
       {apply_no_fov(out + " --fov"), "--fov", 2},
