@@ -125,8 +125,13 @@ void write_flat(const std::string& path, const RenderFrame& frame, const std::ve
     if (p.with_camera) {
       float w2c[4][4], w2n[4][4];
       camera_matrices(frame.camera, w2c, w2n);
-      Imf::addWorldToCamera(h, Imath::M44f(w2c));
-      Imf::addWorldToNDC(h, Imath::M44f(w2n));
+      Imath::M44f a(w2c), b(w2n);
+      if (p.world != Imath::M44d()) {  // identity: the matrices as camera_matrices gives them, bit for bit
+        a = Imath::M44f(p.world * Imath::M44d(a));
+        b = Imath::M44f(p.world * Imath::M44d(b));
+      }
+      Imf::addWorldToCamera(h, a);
+      Imf::addWorldToNDC(h, b);
     }
     headers.push_back(h);
   }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <Imath/ImathBox.h>
+#include <Imath/ImathMatrix.h>
 #include <OpenEXR/ImfPixelType.h>
 
 #include "fogcl/camera.h"
@@ -42,6 +43,8 @@ struct Part {
   std::vector<Channel> channels;
   bool with_camera = false;   // adds worldToCamera / worldToNDC of the frame's camera
   bool tiled = false;
+  Imath::M44d world{};        // with_camera: a rigid motion of the world first (row vectors: worldToCamera =
+                              // world * camera_matrices' worldToCamera; identity by default)
 };
 
 // Writes a flat file: one part -> single-part file, several -> multi-part. Every part has the

@@ -9,6 +9,7 @@
 #include "cli/height_cli.h"
 #include "cli/volumes_cli.h"
 #include "fogcl/fogcl.h"
+#include "fogcl/volume_report.h"
 
 namespace fogcl::cli {
 
@@ -94,6 +95,8 @@ struct ReportCliOptions {
   std::vector<std::string> scenes, integrators;
 };
 int run_report(const ReportCliOptions& options);
+// --volumetric: the report's options from the flags (their rules checked, naming the flag or value).
+VolumeReportOptions volume_report_options(const ReportCliOptions& options);
 int run_volume_report_cli(const ReportCliOptions& options);
 
 }  // namespace fogcl::cli

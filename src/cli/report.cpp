@@ -56,8 +56,7 @@ int run_report(const ReportCliOptions& o) {
   return 0;
 }
 
-int run_volume_report_cli(const ReportCliOptions& o) {
-  namespace fs = std::filesystem;
+VolumeReportOptions volume_report_options(const ReportCliOptions& o) {
   VolumeReportOptions options;
   options.width = o.width;
   options.height = o.height;
@@ -75,7 +74,13 @@ int run_volume_report_cli(const ReportCliOptions& o) {
         throw Error("--integrators: '" + name + "' is not one of stylized, physical");
     }
   }
-  validate(options);  // bad options are one line, before the device opens
+  validate(options);
+  return options;
+}
+
+int run_volume_report_cli(const ReportCliOptions& o) {
+  namespace fs = std::filesystem;
+  VolumeReportOptions options = volume_report_options(o);  // bad options are one line, before the device opens
   const std::string resolved = resolve_device_choice(o.device);
   if (resolved == "scalar")
     throw Error("fogcl report --volumetric measures OpenCL kernel variants; the scalar path (--device scalar) has none");
