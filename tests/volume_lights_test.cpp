@@ -1,7 +1,8 @@
 // Local lights in the volume march (docs/volumetric.md#local-lights) against a float64 quadrature
 // of the same integral (tests/light_reference.h, none of the formula headers), on the scalar path
-// in double and float and on the OpenCL kernel; the extreme placements; and properties of random
-// lights: finite, never darker than without them, culled lights bit-identical to none.
+// in double and float and on the OpenCL kernel; the extreme placements; properties of random
+// lights: finite, never darker than without them, culled lights bit-identical to none; and in a
+// marched height fog whose extinction differs per channel, each channel as that channel's grey fog.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,7 @@
 #include "fogcl/depth_kinds.h"
 #include "fogcl/error.h"
 #include "light_reference.h"
+#include "volume/volume_formulas.h"
 #include "volume_support.h"
 
 namespace fogcl::test {
@@ -469,6 +471,166 @@ TEST(VolumeLights, HeightFogGlowsAsTheQuadratureSays) {
       EXPECT_LE(r.kernel.worst, 1e-2) << c.name;
     }
   }
+}
+
+// A marched height fog whose extinction differs per channel, in-scattering equal to extinction:
+// channel c of the frame is channel c of the same frame under the grey fog beta_c in all three
+// channels (volumes, lights, main light, fog and sun colours unchanged), on the kernel and the
+// scalar path in float and double; random fogs (falloff, start, cut-off, sky), volumes and point
+// and spot lights. The lights add finite, non-negative light to the per-channel frame.
+struct RgbFogCase {
+  LightFrame frame;
+  VolumeSettings settings;
+  glm::vec3 beta;
+};
+
+RgbFogCase random_rgb_fog_case(std::mt19937& rng, int i) {
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const auto in_box = [&](float lo, float hi) {
+    return glm::vec3(lo + (hi - lo) * u(rng), lo + (hi - lo) * u(rng), 3.0f + 14.0f * u(rng));
+  };
+  std::vector<ref::Medium> media;
+  for (int m = 0; m < 1 + i % 2; ++m)
+    media.push_back({glm::dvec3(in_box(-3.0f, 3.0f)), 1.0 + 3.0 * u(rng), 1.5 * u(rng),
+                     glm::dvec3(u(rng), u(rng), u(rng)), 1.6 * u(rng) - 0.8});
+  std::vector<LocalLight> lights;
+  for (int k = 0; k < 2 + i % 2; ++k) {
+    LocalLight l = point_at(in_box(-4.0f, 4.0f), 5.0f + 60.0f * u(rng), 3.0f + 12.0f * u(rng), 0.01f + 0.2f * u(rng));
+    l.color = glm::vec3(0.3f + 0.7f * u(rng), 0.3f + 0.7f * u(rng), 0.3f + 0.7f * u(rng));
+    if (k % 2) {  // every frame has a point and a spot light
+      l.kind = LightKind::spot;
+      l.direction = in_box(-2.0f, 2.0f) - l.position;
+      l.outer_angle = 10.0f + 80.0f * u(rng);
+      l.inner_angle = l.outer_angle * u(rng);
+    }
+    lights.push_back(l);
+  }
+  RgbFogCase c{light_frame(media, lights), light_settings(8 + 8 * (i % 5)), {}};
+  LightFrame& f = c.frame;
+  f.scene.light.direction = glm::vec3(0.3f, 0.4f, 1.0f);
+  f.scene.light.color = glm::vec3(0.8f, 0.7f, 0.6f) * u(rng);
+  for (FogVolume& v : f.scene.volumes) v.ambient = glm::vec3(0.1f * u(rng));
+  // A wall from eye depth 8 (left) to 40 (right); the last columns are sky.
+  DepthImage eye(kW, kH, 0.0f);
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) eye.data()[std::size_t(y) * kW + x] = 8.0f + 32.0f * x / (kW - 1);
+  to_raw_depth(eye, DepthKind::eye, f.params);
+  for (int y = 0; y < kH; ++y)
+    for (int x = kW - 5; x < kW; ++x) eye.data()[std::size_t(y) * kW + x] = 1.0f;
+  f.depth = eye;
+  c.beta = glm::vec3(0.005f + 0.12f * u(rng), 0.005f + 0.12f * u(rng), 0.005f + 0.12f * u(rng));
+  FogSettings fog;
+  fog.mode = FogMode::height;
+  fog.color = glm::vec3(u(rng), u(rng), u(rng));
+  fog.height.falloff = i % 3 == 0 ? 0.0f : 0.3f * u(rng) - 0.1f;
+  fog.height.base_height = 2.0f * u(rng) - 1.0f;
+  // Volumes also before the fog's start and past its cut-off: their light dimmed by the whole
+  // fog's depth per channel, or by none of it.
+  fog.height.start = i % 4 >= 2 ? 8.0f * u(rng) : 0.0f;
+  if (i % 5 == 1 || i % 5 == 3) fog.height.cutoff = fog.height.start + 4.0f + 8.0f * u(rng);
+  fog.fog_skybox = i % 2 == 0;
+  SunLobe sun;
+  sun.direction = f.scene.light.direction;
+  sun.color = glm::vec3(u(rng), u(rng), u(rng));
+  sun.exponent = 4.0f + 8.0f * u(rng);
+  fog.height.sun = sun;
+  fog.height.extinction = fog.height.inscattering = c.beta;
+  c.settings.height_fog = fog;
+  c.settings.resolution_divisor = i % 3 == 2 ? 2 : 1;
+  c.settings.jitter = i % 2 == 1;
+  f.scene.frame_index = unsigned(i);
+  return c;
+}
+
+// The frame of one case on each path: kernel (where there is a device), scalar float and double.
+struct RgbFogFrames {
+  ColorImage kernel, scalar_float;
+  std::vector<double> scalar_double;
+  std::string kernel_options;
+};
+
+RgbFogFrames render_rgb_fog(const LightFrame& f, const VolumeSettings& s) {
+  RgbFogFrames r;
+  if (runtime() != nullptr) {
+    static VolumePass pass(*runtime());
+    pass.apply(f.color, f.depth, r.kernel, f.params, f.scene, s);
+    r.kernel_options = pass.last_march_options();
+  }
+  apply_volumes_scalar(f.color, f.depth, r.scalar_float, f.params, f.scene, s);
+  const VolumeResult<double> d = volumes_scalar<double>(f.color, f.depth, f.params, f.scene, s);
+  r.scalar_double.assign(d.rgba.begin(), d.rgba.end());
+  return r;
+}
+
+// The VOL_FEATURES of a march's build options.
+int march_features(const std::string& options) {
+  const std::size_t at = options.find("VOL_FEATURES=");
+  return at == std::string::npos ? 0 : std::stoi(options.substr(at + 13));
+}
+
+TEST(VolumeLights, PerChannelFogIsEachChannelsGreyFog) {
+  std::mt19937 rng(11);
+  // |per-channel - grey| / max(1, |grey|), worst over pixels and channels, per path
+  double worst_kernel = 0, worst_float = 0, worst_double = 0, most_added = 0;
+  int darker = 0, nonfinite = 0, rgb_variants = 0, frames = 0;
+  const auto err = [](double a, double b) {
+    const double e = std::fabs(a - b) / std::max(1.0, std::fabs(b));
+    return std::isnan(e) ? INFINITY : e;
+  };
+  for (int i = 0; i < 8; ++i) {
+    const RgbFogCase c = random_rgb_fog_case(rng, i);
+    const RgbFogFrames rgb = render_rgb_fog(c.frame, c.settings);
+    const int features = march_features(rgb.kernel_options);
+    rgb_variants += (features & VOL_FEATURE_HEIGHT_RGB) && (features & VOL_FEATURE_LIGHTS) &&
+                    (features & VOL_FEATURE_SPOT);
+    for (int ch = 0; ch < 3; ++ch) {
+      VolumeSettings grey = c.settings;
+      grey.height_fog->height.extinction = grey.height_fog->height.inscattering = glm::vec3(c.beta[ch]);
+      const RgbFogFrames g = render_rgb_fog(c.frame, grey);
+      for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+          const std::size_t at = 4 * (std::size_t(y) * kW + x) + ch;
+          worst_double = std::max(worst_double, err(rgb.scalar_double[at], g.scalar_double[at]));
+          worst_float = std::max(worst_float, err(rgb.scalar_float.pixel(x, y)[ch], g.scalar_float.pixel(x, y)[ch]));
+          if (runtime() != nullptr)
+            worst_kernel = std::max(worst_kernel, err(rgb.kernel.pixel(x, y)[ch], g.kernel.pixel(x, y)[ch]));
+        }
+    }
+    // The lights' part of the per-channel frame: finite and >= 0 on every path.
+    LightFrame dark = c.frame;
+    dark.scene.lights.clear();
+    const RgbFogFrames unlit = render_rgb_fog(dark, c.settings);
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        for (int ch = 0; ch < 3; ++ch) {
+          const std::size_t at = 4 * (std::size_t(y) * kW + x) + ch;
+          std::vector<std::pair<double, double>> pairs = {
+              {rgb.scalar_double[at], unlit.scalar_double[at]},
+              {rgb.scalar_float.pixel(x, y)[ch], unlit.scalar_float.pixel(x, y)[ch]}};
+          if (runtime() != nullptr) pairs.push_back({rgb.kernel.pixel(x, y)[ch], unlit.kernel.pixel(x, y)[ch]});
+          for (const auto& [with, without] : pairs) {
+            nonfinite += !std::isfinite(with);
+            darker += with < without;
+            most_added = std::max(most_added, with - without);
+          }
+        }
+    ++frames;
+  }
+  char kernel[32] = "(no device)";
+  if (runtime() != nullptr) std::snprintf(kernel, sizeof kernel, "%.3g", worst_kernel);
+  std::printf("  %d frames, per-channel fog against each channel's grey fog: worst |rgb - grey| / max(1, |grey|) "
+              "scalar<double> %.3g, scalar<float> %.3g, kernel %s (%d of %d kernels the per-channel light "
+              "variant)\n  lights in the per-channel fog: %d darker and %d non-finite channels, most added %.3g\n",
+              frames, worst_double, worst_float, kernel, rgb_variants, frames, darker, nonfinite, most_added);
+  EXPECT_LE(worst_double, 1e-12);
+  EXPECT_LE(worst_float, 2e-6);
+  EXPECT_LE(worst_kernel, 2e-6);
+  if (runtime() != nullptr) {
+    EXPECT_EQ(rgb_variants, frames);
+  }
+  EXPECT_EQ(darker, 0);
+  EXPECT_EQ(nonfinite, 0);
+  EXPECT_GT(most_added, 0.01);
 }
 
 }  // namespace
