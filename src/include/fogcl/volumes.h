@@ -165,8 +165,8 @@ struct VolumeSettings {
   // The height fog marched with the volumes (docs/DESIGN.md §6.5): light shafts where the shadow
   // map shadows the sun. Unset (default): no height fog in this pass, and no code for it. Set: its
   // mode must be FogMode::height; the fog is §6's (FogSettings::height, color, density,
-  // fog_skybox), with the physical integrator, grey extinction (one β_ext for all three channels;
-  // in-scattering may differ per channel), maximum opacity 1, and at most 31 visible volumes. The
+  // fog_skybox), with the physical integrator (extinction and in-scattering may differ per
+  // channel), maximum opacity 1, and at most 31 visible volumes. The
   // lobe's direction is FogSettings::height.sun's (give it the main light's direction). The
   // deferred pass must then not also apply the height fog: this pass's composite replaces it.
   std::optional<FogSettings> height_fog;
