@@ -40,7 +40,8 @@
 //        device one pixel per work-item (CpuCodegen::one_pixel_per_work_item), 2: the scalar float
 //        pass, one thread (march_ms: the whole pass, whose composite is a small part), 3: the
 //        OpenMP peer's march (2 threads); cpu_ms: the process's CPU time per frame (all threads:
-//        on a loaded machine the wall time is the load's as much as the code's)
+//        on a loaded machine the wall time is the load's as much as the code's); lights N: N
+//        street-lamp point lights (street_lamps) in the fog: N = 0, 1, 2, 4 give each light's cost
 // BM_VolumeDevice, BM_VolumeComposite and BM_VolumeCompositeKernel also time a 2-thread memcpy of
 // the frame's color (in its storage) and depth (memcpy2_ms) for composite_vs_memcpy2 = composite
 // time / that copy: the median of 7 after the loop, or (BM_VolumeCompositeKernel) one copy after
@@ -301,11 +302,28 @@ FogSettings marched_height_fog(bool rgb) {
   return f;
 }
 
+// n point lights along the demo's view (lamps 6 world units apart on both sides), each reaching
+// 12 world units: every light lights a part of the fog in the frame.
+std::vector<LocalLight> street_lamps(int n) {
+  std::vector<LocalLight> lights;
+  for (int i = 0; i < n; ++i) {
+    LocalLight l;
+    l.position = glm::vec3(i % 2 ? 2.5f : -2.5f, 2.5f, 2.0f + 6.0f * float(i / 2) + 3.0f * float(i % 2));
+    l.color = glm::vec3(1.0f, 0.8f, 0.55f);
+    l.intensity = 8.0f;
+    l.range = 12.0f;
+    l.radius = 0.1f;
+    lights.push_back(l);
+  }
+  return lights;
+}
+
 void BM_VolumeHeight(benchmark::State& state) {
   const int path = int(state.range(0));
   const DemoFrame& f = frame(1920);
   VolumeScene s = scene(VolumeIntegrator::physical);
   if (!state.range(1)) s.volumes.clear();
+  s.lights = street_lamps(int(state.range(3)));
   VolumeSettings st = settings(VolumeIntegrator::physical, 2, false);
   st.height_fog = marched_height_fog(state.range(2) != 0);
   double march_ms = 0;
@@ -592,14 +610,20 @@ BENCHMARK(BM_VolumeDevice)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeHeight)
-    ->ArgNames({"path", "volumes", "rgb"})
-    ->ArgsProduct({{0, 1, 3}, {0, 1}, {0, 1}})
+    ->ArgNames({"path", "volumes", "rgb", "lights"})
+    ->ArgsProduct({{0, 1, 3}, {0, 1}, {0, 1}, {0}})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.5);
+BENCHMARK(BM_VolumeHeight)  // each point light's cost: the OpenCL pass and the OpenMP peer
+    ->ArgNames({"path", "volumes", "rgb", "lights"})
+    ->ArgsProduct({{0, 3}, {1}, {0}, {1, 2, 4}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeHeight)  // the scalar march: seconds a frame
-    ->ArgNames({"path", "volumes", "rgb"})
-    ->ArgsProduct({{2}, {0, 1}, {0}})
+    ->ArgNames({"path", "volumes", "rgb", "lights"})
+    ->ArgsProduct({{2}, {0, 1}, {0}, {0, 4}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(1);
