@@ -69,9 +69,6 @@ std::vector<FogVolume> demo_fog_volumes(VolumeIntegrator integrator) {
   return volumes;
 }
 
-}  // namespace fogcl
-
-namespace fogcl {
 
 FogSettings demo_shaft_fog() {
   // A ground haze a few units deep (thins by e per 1/0.3 units of height), thick enough that the
@@ -92,9 +89,6 @@ FogSettings demo_shaft_fog() {
   return f;
 }
 
-}  // namespace fogcl
-
-namespace fogcl {
 
 std::vector<LocalLight> demo_street_lamps() {
   // Three street lamps on 4.5-unit poles along the left of the view and one on the right, spots
@@ -145,9 +139,6 @@ FogSettings demo_night_fog() {
   return f;
 }
 
-}  // namespace fogcl
-
-namespace fogcl {
 
 DemoFrame demo_night_frame(int width, int height) {
   DemoFrame frame = render_demo_scene(width, height);
