@@ -283,99 +283,187 @@ VOL_FN VOL_REAL vol_covered(const VOL_REAL* t_in, const VOL_REAL* t_out, VOL_UIN
   return covered;
 }
 
-/* Local lights (docs/volumetric.md#local-lights). The ray's stretch inside each light's range
- * sphere, clipped to [t_from, t_scene], once per ray: a segment outside it skips the light.
- * t_from <= 0 is where the march starts (the marched height fog starts at the eye, before the
- * ray's origin on the near plane). */
-VOL_FN void vol_light_spans(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_from, VOL_REAL t_scene,
-                            VOL_GLOBAL const float* lights, int n, VOL_REAL* l_in, VOL_REAL* l_out) {
-  const VOL_V3 from = origin + dir * t_from;
+#endif /* VOL_LANE_INSTANCE */
+
+/* Local lights (docs/volumetric.md#local-lights), in every instance: the lanes kernel runs them on
+ * 16 rays' segments at once. A ray's constants per light, VOL_LR_* in lr (vol_light_rays): the
+ * stretch [in, out] of the ray inside the light's range sphere (a lane whose ray misses it: in =
+ * +inf, out = 0), the ray parameter t0 of the closest approach, sc = sqrt(h^2 + radius^2) and its
+ * reciprocal (h: the ray's distance from the light), h^2, and for spot lights
+ * dot(position - origin, axis) and dot(dir, axis). */
+#define VOL_LR_IN 0
+#define VOL_LR_OUT 1
+#define VOL_LR_T0 2
+#define VOL_LR_SC 3
+#define VOL_LR_INV_SC 4
+#define VOL_LR_H2 5
+#define VOL_LR_AXIS_AT 6
+#define VOL_LR_AXIS_DIR 7
+#define VOL_LR_STRIDE 8
+
+/* The lights whose range sphere the ray meets within [t_from, t_scene] (in some lane), once per
+ * ray: their indices in ids[0, returned count) and their constants in lr, in that order. A light
+ * no ray of the work-item reaches costs nothing after this; a segment outside a light's stretch
+ * costs a comparison. t_from <= 0 is where the march starts (the marched height fog starts at
+ * the eye, before the ray's origin on the near plane). */
+VOL_FN int vol_light_rays(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_from, VOL_REAL t_scene,
+                          VOL_GLOBAL const float* lights, int n, int features, VOL_REAL* lr, int* ids) {
+  int active = 0;
   for (int k = 0; k < n; ++k) {
     VOL_GLOBAL const float* light = lights + k * VOL_L_STRIDE;
-    VOL_REAL t0, t1;
-    const int hit = vol_sphere_hit(from, dir, VOL_P3(light, VOL_L_POSITION), VOL_P(light, VOL_L_RANGE), &t0, &t1);
-    l_in[k] = hit ? t_from + t0 : (VOL_REAL)INFINITY;
-    l_out[k] = hit ? fmin(t_from + t1, t_scene) : (VOL_REAL)0;
+    const VOL_REAL rx = VOL_PU(light, VOL_L_POSITION) - origin.x, ry = VOL_PU(light, VOL_L_POSITION + 1) - origin.y,
+                   rz = VOL_PU(light, VOL_L_POSITION + 2) - origin.z;
+    const VOL_REAL t0 = rx * dir.x + ry * dir.y + rz * dir.z;
+    const VOL_REAL px = rx - dir.x * t0, py = ry - dir.y * t0, pz = rz - dir.z * t0;
+    const VOL_REAL h2 = px * px + py * py + pz * pz;
+    const VOL_U range = VOL_PU(light, VOL_L_RANGE);
+    const VOL_REAL disc = range * range - h2, chord = sqrt(fmax(disc, (VOL_REAL)0));
+    const VOL_REAL in = fmax(t0 - chord, t_from), out = fmin(t0 + chord, t_scene);
+    const VOL_INT hit = disc > (VOL_REAL)0 && out > in;
+    if (!VOL_ANY(hit)) continue;
+    VOL_REAL* r = lr + active * VOL_LR_STRIDE;
+    const VOL_REAL sc = sqrt(h2 + VOL_PU(light, VOL_L_RADIUS2));
+    r[VOL_LR_IN] = hit ? in : (VOL_REAL)INFINITY;
+    r[VOL_LR_OUT] = hit ? out : (VOL_REAL)0;
+    r[VOL_LR_T0] = t0;
+    r[VOL_LR_SC] = sc;
+    r[VOL_LR_INV_SC] = (VOL_REAL)1 / sc;
+    r[VOL_LR_H2] = h2;
+    if (features & VOL_FEATURE_SPOT) {
+      const VOL_U ax = VOL_PU(light, VOL_L_AXIS), ay = VOL_PU(light, VOL_L_AXIS + 1), az = VOL_PU(light, VOL_L_AXIS + 2);
+      r[VOL_LR_AXIS_AT] = rx * ax + ry * ay + rz * az;
+      r[VOL_LR_AXIS_DIR] = dir.x * ax + dir.y * ay + dir.z * az;
+    }
+    ids[active++] = k;
   }
+  return active;
 }
 
 /* sigma_s * phase toward the eye of the media at a point lit from cos_theta (between the ray and
- * the direction toward the light): each volume of `mask` with its albedo and Henyey-Greenstein g
- * (each[i]: its extinction), plus fog_scatter (the marched height fog's scattering coefficient
- * per channel) with the isotropic phase. */
-VOL_FN VOL_V3 vol_light_scatter(VOL_REAL cos_theta, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols,
-                                int count, VOL_V3 fog_scatter) {
-  VOL_V3 s = fog_scatter * (VOL_REAL)(1.0 / (4.0 * 3.14159265358979323846));
+ * the direction toward the light), per channel in s[0..2]: each volume of `mask` with its albedo
+ * and Henyey-Greenstein g (each[i]: its extinction, 0 outside mask), plus fog_scatter (the marched
+ * height fog's scattering coefficient per channel) with the isotropic phase. */
+VOL_FN void vol_light_scatter(VOL_REAL cos_theta, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols,
+                              int count, VOL_V3 fog_scatter, VOL_REAL* s) {
+  const VOL_REAL iso = (VOL_REAL)(1.0 / (4.0 * 3.14159265358979323846));
+  s[0] = fog_scatter.x * iso;
+  s[1] = fog_scatter.y * iso;
+  s[2] = fog_scatter.z * iso;
   for (int i = 0; i < count; ++i) {
-    if (!((mask >> i) & 1u)) continue;
+    if (!VOL_ANY(((mask >> i) & 1u) != 0u)) continue;
     VOL_GLOBAL const float* vol = vols + i * VOL_V_STRIDE;
-    s = s + VOL_P3(vol, VOL_V_ALBEDO) * (each[i] * vol_phase_hg(cos_theta, VOL_PU(vol, VOL_V_ANISOTROPY)));
+    const VOL_REAL m = each[i] * vol_phase_hg(cos_theta, VOL_PU(vol, VOL_V_ANISOTROPY));
+    s[0] += VOL_PU(vol, VOL_V_ALBEDO) * m;
+    s[1] += VOL_PU(vol, VOL_V_ALBEDO + 1) * m;
+    s[2] += VOL_PU(vol, VOL_V_ALBEDO + 2) * m;
   }
-  return s;
+}
+
+/* The mean of e^(-sigma u) over a length of optical thickness `thick`: (1 - e^-thick) / thick. */
+VOL_FN VOL_REAL vol_mean_transmittance(VOL_REAL thick) {
+  return thick > (VOL_REAL)0 ? -expm1(-thick) / thick : (VOL_REAL)1;
+}
+
+/* One piece [x0, x1] of a light's stretch of the segment starting at s0 (x = (t - t0) / sc, the
+ * light's ray constants r; the piece starts at ray parameter ta and is len long), where `live`:
+ * its inverse-square mass (int dt / (u^2 + sc^2) over it, exactly) times the mean transmittance
+ * over it (whole_piece: the piece is the segment, whose mean `whole` the caller has) times the
+ * scattering, the window and the cone at the piece's angular midpoint, added per channel to sum. */
+VOL_FN void vol_light_piece(VOL_REAL x0, VOL_REAL x1, VOL_REAL ta, VOL_REAL len, VOL_REAL mass, VOL_INT live,
+                            VOL_INT whole_piece, const VOL_REAL* r, VOL_GLOBAL const float* light, VOL_REAL s0,
+                            const VOL_REAL* sigma_t, const VOL_REAL* depth, int channels, const VOL_REAL* whole,
+                            const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols, int count,
+                            VOL_V3 fog_scatter, int features, VOL_REAL* sum) {
+  /* tan((phi0 + phi1) / 2) from x = tan(phi): (sin phi0 + sin phi1) / (cos phi0 + cos phi1), whose
+   * terms never cancel in the denominator (|phi| < pi / 2) */
+  const VOL_REAL r0 = sqrt((VOL_REAL)1 + x0 * x0), r1 = sqrt((VOL_REAL)1 + x1 * x1);
+  const VOL_REAL um = (x0 * r1 + x1 * r0) / (r0 + r1) * r[VOL_LR_SC]; /* t - t0 at the midpoint */
+  const VOL_REAL d2 = um * um + r[VOL_LR_H2];
+  const VOL_REAL w = (VOL_REAL)1 - d2 * VOL_PU(light, VOL_L_INV_RANGE2);
+  const VOL_INT lit = live && w > (VOL_REAL)0;
+  if (!VOL_ANY(lit)) return;
+  const VOL_REAL d = sqrt(d2);
+  /* toward the light: dot(dir, position - p) = t0 - t = -um */
+  const VOL_REAL cos_theta = d > (VOL_REAL)0 ? -um / d : (VOL_REAL)0;
+  VOL_REAL weight = w * w * mass;
+  if (features & VOL_FEATURE_SPOT) {
+    const VOL_REAL cos_axis =
+        d > (VOL_REAL)0 ? ((r[VOL_LR_T0] + um) * r[VOL_LR_AXIS_DIR] - r[VOL_LR_AXIS_AT]) / d : (VOL_REAL)1;
+    const VOL_REAL f = vol_saturate(cos_axis * VOL_PU(light, VOL_L_SPOT_SCALE) + VOL_PU(light, VOL_L_SPOT_OFFSET));
+    weight = weight * f * f;
+  }
+  VOL_REAL t[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0};
+  const VOL_INT part = live && !whole_piece;
+  for (int c = 0; c < channels; ++c) {
+    t[c] = whole[c];
+    if (VOL_ANY(part))
+      t[c] = whole_piece ? t[c]
+                         : exp(-(depth[c] + sigma_t[c] * fmax(ta - s0, (VOL_REAL)0))) *
+                               vol_mean_transmittance(sigma_t[c] * len);
+  }
+  if (channels == 1) t[1] = t[2] = t[0];
+  VOL_REAL s[3];
+  vol_light_scatter(cos_theta, each, mask, vols, count, fog_scatter, s);
+  for (int c = 0; c < 3; ++c) sum[c] = lit ? sum[c] + s[c] * t[c] * weight : sum[c];
 }
 
 /* The local lights' in-scattered radiance over the segment [s0, s1] of a ray, extinction sigma_t
  * in it (constant), optical depth `depth` before it, each per channel (`channels` 3: the marched
- * fog's extinction differs per channel; 1: element 0 serves three). For each light whose span meets the segment,
- * its part [a, b] is cut into pieces of at most VOL_LIGHT_ANGLE_STEP as seen from the light; on a
- * piece [ua, ub] (u = t - t0, t0 the ray's closest approach, c = h^2 + radius^2) the inverse
+ * fog's extinction differs per channel; 1: element 0 serves three); the ray's lights from
+ * vol_light_rays (lr, ids, n). For each light whose stretch meets the segment, its part [a, b] is
+ * cut into pieces of at most VOL_LIGHT_ANGLE_STEP as seen from the light (one, unless the segment
+ * passes close to the light); on a piece [ua, ub] (u = t - t0, c = h^2 + radius^2) the inverse
  * square is integrated exactly, int du / (u^2 + c) = (angle subtended) / sqrt(c), and the
  * transmittance by its mean over the piece, T(ua) (1 - e^(-sigma_t (ub - ua))) / (sigma_t (ub - ua));
  * the window, the cone and the phase are taken at the piece's angular midpoint. A sample at the
- * light or a ray through it is finite: c >= radius^2 > 0. */
-VOL_FN VOL_V3 vol_lights_segment(VOL_V3 origin, VOL_V3 dir, VOL_REAL s0, VOL_REAL s1, const VOL_REAL* sigma_t,
-                                 const VOL_REAL* depth, int channels, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols, int count,
-                                 VOL_V3 fog_scatter, VOL_GLOBAL const float* lights, int n_lights,
-                                 const VOL_REAL* l_in, const VOL_REAL* l_out, int features) {
-  VOL_V3 sum = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
-  for (int k = 0; k < n_lights; ++k) {
-    const VOL_REAL a = fmax(s0, l_in[k]), b = fmin(s1, l_out[k]);
-    if (!(b > a)) continue; /* the segment is outside the light's range */
-    VOL_GLOBAL const float* light = lights + k * VOL_L_STRIDE;
-    const VOL_V3 pos = VOL_P3(light, VOL_L_POSITION), rel = pos - origin;
-    const VOL_REAL t0 = dot(rel, dir);
-    const VOL_V3 perp = rel - dir * t0;
-    const VOL_REAL sc = sqrt(dot(perp, perp) + VOL_P(light, VOL_L_RADIUS2));
-    const VOL_REAL xa = (a - t0) / sc, xb = (b - t0) / sc;
-    /* atan(xb) - atan(xa) without the cancellation of two angles near +-pi/2 (a far segment) */
-    const VOL_REAL span = xa * xb > (VOL_REAL)-1 ? atan((b - a) / sc / ((VOL_REAL)1 + xa * xb)) : atan(xb) - atan(xa);
-    const int n = min(VOL_LIGHT_MAX_PIECES, max(1, (int)ceil(span / (VOL_REAL)VOL_LIGHT_ANGLE_STEP)));
-    const VOL_REAL piece = span / (VOL_REAL)n, phi_a = atan(xa);
-    const VOL_REAL mass = piece / sc; /* int du / (u^2 + c) over one piece */
-    VOL_REAL x1 = xa;
-    VOL_V3 light_sum = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
-    for (int j = 0; j < n; ++j) {
-      const VOL_REAL x0 = x1;
-      x1 = j + 1 == n ? xb : fmin(fmax(tan(phi_a + piece * (VOL_REAL)(j + 1)), x0), xb);
-      const VOL_REAL xm = fmin(fmax(tan(phi_a + piece * ((VOL_REAL)j + (VOL_REAL)0.5f)), x0), x1);
-      const VOL_REAL ta = t0 + x0 * sc, len = (x1 - x0) * sc, tm = t0 + xm * sc;
-      VOL_REAL transmittance[3];
-      for (int c = 0; c < channels; ++c) {
-        const VOL_REAL thick = sigma_t[c] * len;
-        const VOL_REAL mean = thick > (VOL_REAL)0 ? -expm1(-thick) / thick : (VOL_REAL)1;
-        transmittance[c] = exp(-(depth[c] + sigma_t[c] * fmax(ta - s0, (VOL_REAL)0))) * mean;
-      }
-      if (channels == 1) transmittance[1] = transmittance[2] = transmittance[0];
-      const VOL_V3 to_light = pos - (origin + dir * tm);
-      const VOL_REAL d2 = dot(to_light, to_light);
-      const VOL_REAL w = (VOL_REAL)1 - d2 * VOL_P(light, VOL_L_INV_RANGE2);
-      if (!(w > (VOL_REAL)0)) continue;
-      const VOL_REAL d = sqrt(d2);
-      const VOL_REAL cos_theta = d > (VOL_REAL)0 ? dot(dir, to_light) / d : (VOL_REAL)0;
-      VOL_REAL cone = (VOL_REAL)1;
-      if (features & VOL_FEATURE_SPOT) {
-        const VOL_REAL cos_axis = d > (VOL_REAL)0 ? -dot(to_light, VOL_P3(light, VOL_L_AXIS)) / d : (VOL_REAL)1;
-        const VOL_REAL f = vol_saturate(cos_axis * VOL_P(light, VOL_L_SPOT_SCALE) + VOL_P(light, VOL_L_SPOT_OFFSET));
-        cone = f * f;
-      }
-      const VOL_V3 scatter = vol_light_scatter(cos_theta, each, mask, vols, count, fog_scatter) * (w * w * cone);
-      light_sum = light_sum + VOL_MAKE3(scatter.x * transmittance[0], scatter.y * transmittance[1],
-                                        scatter.z * transmittance[2]);
+ * light or a ray through it is finite: c >= radius^2 > 0. The angle between the pieces' ends is
+ * atan2 of the tangent difference formula, exact for the segment's whole stretch and without the
+ * cancellation of two angles near +-pi/2 (a far segment). */
+VOL_FN VOL_V3 vol_lights_segment(VOL_REAL s0, VOL_REAL s1, const VOL_REAL* sigma_t, const VOL_REAL* depth,
+                                 int channels, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols,
+                                 int count, VOL_V3 fog_scatter, VOL_GLOBAL const float* lights, const VOL_REAL* lr,
+                                 const int* ids, int n, int features) {
+  VOL_REAL sum[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0}, whole[3];
+  int have_whole = 0;
+  for (int q = 0; q < n; ++q) {
+    const VOL_REAL* r = lr + q * VOL_LR_STRIDE;
+    const VOL_REAL a = fmax(s0, r[VOL_LR_IN]), b = fmin(s1, r[VOL_LR_OUT]);
+    const VOL_INT on = b > a;
+    if (!VOL_ANY(on)) continue; /* the segment is outside the light's range */
+    if (!have_whole) { /* the segment's mean transmittance, shared by the lights that cover it */
+      for (int c = 0; c < channels; ++c) whole[c] = exp(-depth[c]) * vol_mean_transmittance(sigma_t[c] * (s1 - s0));
+      have_whole = 1;
     }
-    sum = sum + VOL_P3(light, VOL_L_RADIANCE) * mass * light_sum;
+    VOL_GLOBAL const float* light = lights + ids[q] * VOL_L_STRIDE;
+    const VOL_REAL t0 = r[VOL_LR_T0], sc = r[VOL_LR_SC], inv_sc = r[VOL_LR_INV_SC];
+    const VOL_REAL xa = (a - t0) * inv_sc, xb = (b - t0) * inv_sc;
+    const VOL_REAL span = on ? atan2((b - a) * inv_sc, (VOL_REAL)1 + xa * xb) : (VOL_REAL)0;
+    const VOL_REAL pieces = fmin((VOL_REAL)VOL_LIGHT_MAX_PIECES,
+                                 fmax((VOL_REAL)1, ceil(span / (VOL_REAL)VOL_LIGHT_ANGLE_STEP)));
+    VOL_REAL light_sum[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0};
+    if (VOL_ANY(on && pieces > (VOL_REAL)1)) {
+      /* pieces of equal angle, their ends tan(phi_a + j * piece) kept in order within [xa, xb] */
+      const VOL_REAL piece = span / pieces, phi_a = atan(xa);
+      VOL_REAL x1 = xa;
+      for (int j = 0; j < VOL_LIGHT_MAX_PIECES && VOL_ANY(on && (VOL_REAL)j < pieces); ++j) {
+        const VOL_REAL x0 = x1, next = (VOL_REAL)(j + 1);
+        x1 = next >= pieces ? xb : fmin(fmax(tan(phi_a + piece * next), x0), xb);
+        vol_light_piece(x0, x1, t0 + x0 * sc, (x1 - x0) * sc, piece * inv_sc, on && (VOL_REAL)j < pieces,
+                        (VOL_INT)0, r, light, s0, sigma_t, depth, channels, whole, each, mask, vols, count,
+                        fog_scatter, features, light_sum);
+      }
+    } else {
+      vol_light_piece(xa, xb, a, b - a, span * inv_sc, on, a == s0 && b == s1, r, light, s0, sigma_t, depth,
+                      channels, whole, each, mask, vols, count, fog_scatter, features, light_sum);
+    }
+    sum[0] += VOL_PU(light, VOL_L_RADIANCE) * light_sum[0];
+    sum[1] += VOL_PU(light, VOL_L_RADIANCE + 1) * light_sum[1];
+    sum[2] += VOL_PU(light, VOL_L_RADIANCE + 2) * light_sum[2];
   }
-  return sum;
+  return VOL_MAKE3(sum[0], sum[1], sum[2]);
 }
+
+#ifndef VOL_LANE_INSTANCE
 
 /* The marched height fog's stretch of a ray (docs/DESIGN.md §6.5): §6.2's [s0, s1] in distance
  * from the eye (the view plane), as ray parameters [*t0, *t1] (t = s - s_origin, s_origin the
@@ -514,8 +602,11 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
   /* Local lights: their spans along the ray once; each[] the volumes' extinctions of a segment. */
   const int n_lights = (features & VOL_FEATURE_LIGHTS) ? (int)VOL_P(frame, VOL_F_LIGHT_COUNT) : 0;
   VOL_GLOBAL const float* lights = vols + ((features & VOL_FEATURE_LIGHTS) ? (int)VOL_P(frame, VOL_F_LIGHT_OFFSET) : 0);
-  VOL_REAL l_in[VOL_MAX_LIGHTS], l_out[VOL_MAX_LIGHTS], each[VOL_MAX_VOLUMES];
-  if (n_lights > 0) vol_light_spans(origin, dir, fmin(start, (VOL_REAL)0), t_scene, lights, n_lights, l_in, l_out);
+  VOL_REAL lr[VOL_MAX_LIGHTS * VOL_LR_STRIDE], each[VOL_MAX_VOLUMES];
+  int light_ids[VOL_MAX_LIGHTS];
+  const int ray_lights = n_lights > 0 ? vol_light_rays(origin, dir, fmin(start, (VOL_REAL)0), t_scene, lights,
+                                                       n_lights, features, lr, light_ids)
+                                     : 0;
   const VOL_V3 no_fog = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   /* The fog's extinction per channel (VOL_FEATURE_HEIGHT_RGB) dims the volumes' light per channel. */
   const int channels = (features & VOL_FEATURE_HEIGHT_RGB) ? 3 : 1;
@@ -549,7 +640,7 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
           const VOL_REAL in_before[3] = {fog_in[0], fog_in[1], fog_in[2]};
           vol_height_segment(s0, s1, s_origin, wy, d0, lit, other, depth, hp, hf, fog_ext, fog_in, fog_sun_depth,
                              fog_amb, fog_sun);
-          if (n_lights > 0 && seg > (VOL_REAL)0) {
+          if (ray_lights > 0 && seg > (VOL_REAL)0) {
             /* The fog's scattering coefficient: its in-scattering depth over the segment per unit
              * length (one channel without FOG_HF_RGB); extinctions add as for the main light. */
             const int rgb = (hf & FOG_HF_RGB) != 0;
@@ -560,8 +651,8 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
               sigma_all[c] = (sigma_t > (VOL_REAL)0 ? sigma_t : (VOL_REAL)0) + (fog_ext[c] - ext_before[c]) / seg;
               depth_all[c] = depth + ext_before[c];
             }
-            const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sigma_all, depth_all, channels, each, mask, vols,
-                                                count, fog_scatter, lights, n_lights, l_in, l_out, features);
+            const VOL_V3 l = vol_lights_segment(s0, s1, sigma_all, depth_all, channels, each, mask, vols, count,
+                                                fog_scatter, lights, lr, light_ids, ray_lights, features);
             i_r += l.x;
             i_g += l.y;
             i_b += l.z;
@@ -579,11 +670,11 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
           continue;
         }
         if (!(sigma_t > (VOL_REAL)0)) continue;
-        if (n_lights > 0) {
+        if (ray_lights > 0) {
           VOL_REAL sig3[3], depth3[3];
           for (int c = 0; c < channels; ++c) sig3[c] = sigma_t, depth3[c] = height ? depth + fog_ext[c] : depth;
-          const VOL_V3 l = vol_lights_segment(origin, dir, s0, s1, sig3, depth3, channels, each, mask, vols, count, no_fog,
-                                              lights, n_lights, l_in, l_out, features);
+          const VOL_V3 l = vol_lights_segment(s0, s1, sig3, depth3, channels, each, mask, vols, count, no_fog, lights,
+                                              lr, light_ids, ray_lights, features);
           i_r += l.x;
           i_g += l.y;
           i_b += l.z;

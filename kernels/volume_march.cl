@@ -107,9 +107,6 @@ kernel void volume_march(global const float* depth, global const float* frame, g
 #include "fog_math.h"
 #define VOL_LANE_HEIGHT
 #endif
-#if VOL_FEATURES & VOL_FEATURE_LIGHTS
-#error "local lights run one pixel per work-item"
-#endif
 #ifdef VOL_NOISE_IMAGE
 #error "VOL_LANES 16 reads the noise as a buffer"
 #endif
@@ -314,7 +311,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
    * takes every live lane's next segment, so all lanes sample at once while their pieces differ.
    * Lanes whose ray is done sample nothing (an empty mask) until the last one is. */
   float t_in[16][VOL_MAX_VOLUMES], t_out[16][VOL_MAX_VOLUMES];
-  float a[16], b[16], covered[16], n[16], j[16], cos_theta[16];
+  float a[16], b[16], covered[16], n[16], j[16], cos_theta[16], start[16];
   uint hit[16], mask[16];
   int live[16], pieces[16];
 #if VOL_FEATURES & VOL_FEATURE_HEIGHT
@@ -335,6 +332,7 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     vol_height_ray(o, d, scene[k], t_per_eye[k], frame, hp, VOL_HEIGHT_FEATURES, count, t_in[k], t_out[k], &hit[k],
                    &a[k], &s_origin[k], &d0[k], &tail_from[k], &infinite[k]);
 #endif
+    start[k] = fmin(a[k], 0.0f); /* where the local lights' stretches may begin (vol_physical) */
     cos_theta[k] = dot(d, VOL_PU3(frame, VOL_F_LIGHT_DIR));
     covered[k] = hit[k] != 0u ? vol_covered(t_in[k], t_out[k], hit[k], walked, a[k]) : 0.0f;
     pieces[k] = 0;
@@ -345,6 +343,16 @@ kernel void volume_march(global const float* depth, global const float* frame, g
   }
   float16 phase[VOL_MAX_VOLUMES];
   vol_physical_phases(vload16(0, cos_theta), volumes, count, phase);
+#if VOL_FEATURES & VOL_FEATURE_LIGHTS
+  /* The local lights that some lane's ray meets, their constants lane-wise (vol_physical's). */
+  float16 lr[VOL_MAX_LIGHTS * VOL_LR_STRIDE], each[VOL_MAX_VOLUMES];
+  int light_ids[VOL_MAX_LIGHTS];
+  global const float* lights = volumes + (int)frame[VOL_F_LIGHT_OFFSET];
+  const int ray_lights = vol_light_rays(origin, dir, vload16(0, start), t_scene, lights, (int)frame[VOL_F_LIGHT_COUNT],
+                                        VOL_FEATURES, lr, light_ids);
+#else
+  float16* each = 0;
+#endif
   float16 i_r = 0.0f, i_g = 0.0f, i_b = 0.0f, optical = 0.0f;
   float16 s1 = 0.0f; /* each lane's last segment end: the next segment's start within a piece */
 #if VOL_FEATURES & VOL_FEATURE_HEIGHT
@@ -371,12 +379,13 @@ kernel void volume_march(global const float* depth, global const float* frame, g
     vol_float3x16 source;
     const uint16 volumes_here = alive ? vload16(0, mask) : (uint16)0u;
     const float16 sigma_t = vol_physical_sample(p, t, phase, lit, volumes_here, volumes, count, frame, noise,
-                                                noise_size, VOL_FEATURES, &source, 0);
+                                                noise_size, VOL_FEATURES, &source, each);
     const int16 adds = sigma_t > 0.0f;
 #if VOL_FEATURES & VOL_FEATURE_HEIGHT
     /* vol_physical's fog segment, on the lanes whose segment has the fog; extinctions add. */
     const int16 fogged = (volumes_here & fog_bit) != 0u;
     const float16 ext_before[3] = {fog_ext[0], fog_ext[1], fog_ext[2]};
+    const float16 in_before[3] = {fog_in[0], fog_in[1], fog_in[2]};
     if (VOL_ANY16(fogged)) {
       float16 e[3], in[3], sd[3], am[3], su[3];
       for (int c = 0; c < fog_channels; ++c)
@@ -397,6 +406,30 @@ kernel void volume_march(global const float* depth, global const float* frame, g
         fog_sun[c] = fogged ? su[c] : fog_sun[c];
       }
     }
+#if VOL_FEATURES & VOL_FEATURE_LIGHTS
+    if (ray_lights > 0) {
+      /* vol_physical's lights of a segment: the fog's scattering coefficient where the lane's
+       * segment has the fog, the extinctions added; lanes without a medium scatter nothing. */
+      const int16 has_length = seg > 0.0f;
+      const float16 inv_seg = has_length ? 1.0f / seg : 0.0f;
+      float16 fog_s[3];
+      for (int c = 0; c < 3; ++c) {
+        const int fc = fog_channels == 3 ? c : 0; /* grey fog: channel 0 serves three */
+        fog_s[c] = fogged ? (fog_in[fc] - in_before[fc]) * inv_seg : 0.0f;
+      }
+      float16 sigma_all[3], depth_all[3];
+      for (int c = 0; c < channels; ++c) {
+        sigma_all[c] = (adds ? sigma_t : 0.0f) + (fogged ? (fog_ext[c] - ext_before[c]) * inv_seg : 0.0f);
+        depth_all[c] = optical + ext_before[c];
+      }
+      const vol_float3x16 l = vol_lights_segment(s0, s1, sigma_all, depth_all, channels, each, volumes_here, volumes,
+                                                 count, vol_make3_x16(fog_s[0], fog_s[1], fog_s[2]), lights, lr,
+                                                 light_ids, ray_lights, VOL_FEATURES);
+      i_r += l.x;
+      i_g += l.y;
+      i_b += l.z;
+    }
+#endif
     if (VOL_ANY16(adds)) {
       float16 scatter[3];
       for (int c = 0; c < channels; ++c)
@@ -409,6 +442,17 @@ kernel void volume_march(global const float* depth, global const float* frame, g
       optical = adds ? optical + sigma_t * seg : optical;
     }
 #else
+#if VOL_FEATURES & VOL_FEATURE_LIGHTS
+    if (ray_lights > 0 && VOL_ANY16(adds)) {
+      const float16 sigma_all = adds ? sigma_t : 0.0f;
+      const vol_float3x16 l = vol_lights_segment(s0, s1, &sigma_all, &optical, 1, each, volumes_here, volumes, count,
+                                                 vol_make3_x16(0.0f, 0.0f, 0.0f), lights, lr, light_ids, ray_lights,
+                                                 VOL_FEATURES);
+      i_r += l.x;
+      i_g += l.y;
+      i_b += l.z;
+    }
+#endif
     if (VOL_ANY16(adds)) {
       const float16 scatter = vol_segment_weight(sigma_t, seg, optical, VOL_INTEGRATOR == VOL_RIEMANN);
       i_r = adds ? i_r + source.x * scatter : i_r;

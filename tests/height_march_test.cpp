@@ -400,16 +400,34 @@ TEST(HeightMarchPass, CpuLanesMatchTheOnePixelKernel) {
   one_pixel_codegen.one_pixel_per_work_item = true;
   static VolumePass one_pixel(*runtime(), nullptr, one_pixel_codegen);
   const ShadowMap shadow = synthetic_shadow_map(false);
-  double worst_fog = 0.0, worst_volumes = 0.0;
+  double worst_fog = 0.0, worst_volumes = 0.0, worst_lights = 0.0, brightest_lit = 0.0;
   std::size_t differing_fog = 0;
+  // A point light by the camera and a spot over the ground volume (docs/volumetric.md#local-lights).
+  LocalLight lamp;
+  lamp.position = glm::vec3(1.0f, 1.2f, -2.0f);
+  lamp.color = glm::vec3(1.0f, 0.8f, 0.6f);
+  lamp.intensity = 5.0f;
+  lamp.range = 8.0f;
+  lamp.radius = 0.05f;
+  LocalLight spot = lamp;
+  spot.kind = LightKind::spot;
+  spot.position = glm::vec3(-4.0f, 4.0f, 10.0f);
+  spot.direction = glm::vec3(0.1f, -1.0f, 0.2f);
+  spot.inner_angle = 10.0f;
+  spot.outer_angle = 35.0f;
+  spot.intensity = 40.0f;
+  spot.range = 12.0f;
   for (int seed = 0; seed < kSeeds; ++seed)
-    for (bool volumes : {false, true}) {
-      if (volumes && seed % 2) continue;  // fewer variants to build
+    for (int what : {0, 1, 2}) {  // the fog alone, with volumes, with volumes (even seeds) and lights
+      const bool volumes = what == 1 || (what == 2 && seed % 2 == 0), lights = what == 2;
+      if (what == 1 && seed % 2) continue;  // fewer variants to build
+      if (lights && seed > 4) continue;
       VolumeTestScene t = volume_test_scene(70, 30);  // a row of 35 target pixels: two full lane blocks and a tail
       face_the_light(t);
       if (!volumes) t.scene.volumes.clear();
+      if (lights) t.scene.lights = {lamp, spot};
       VolumeSettings vs;
-      vs.integrator = seed == 4 ? VolumeIntegrator::riemann : VolumeIntegrator::physical;
+      vs.integrator = seed == 4 && !lights ? VolumeIntegrator::riemann : VolumeIntegrator::physical;
       vs.steps = 8 + 7 * seed;
       vs.resolution_divisor = seed % 2 ? 1 : 2;
       vs.height_fog = marched_fog(t.scene, seed);
@@ -425,15 +443,21 @@ TEST(HeightMarchPass, CpuLanesMatchTheOnePixelKernel) {
           for (int c = 0; c < 4; ++c) {
             const float a = got_lanes.pixel(x, y)[c], b = got_one.pixel(x, y)[c];
             const double d = std::fabs(double(a) - double(b));
-            double& worst = volumes ? worst_volumes : worst_fog;
-            worst = std::isnan(d) ? INFINITY : std::max(worst, d);
-            if (!volumes && std::memcmp(&a, &b, sizeof a) != 0) ++differing_fog;
+            // with lights: relative to the value (lit fog is brighter than 1 near a lamp)
+            double& worst = lights ? worst_lights : volumes ? worst_volumes : worst_fog;
+            const double e = lights ? d / std::max(1.0, std::fabs(double(b))) : d;
+            worst = std::isnan(d) ? INFINITY : std::max(worst, e);
+            if (lights) brightest_lit = std::max(brightest_lit, double(b));
+            if (!volumes && !lights && std::memcmp(&a, &b, sizeof a) != 0) ++differing_fog;
           }
     }
-  std::printf("lanes vs one pixel: fog alone worst %.3g (%zu values differ in their bits), with volumes %.3g\n",
-              worst_fog, differing_fog, worst_volumes);
+  std::printf("lanes vs one pixel: fog alone worst %.3g (%zu values differ in their bits), with volumes %.3g, "
+              "with point and spot lights %.3g relative (brightest %.3g)\n",
+              worst_fog, differing_fog, worst_volumes, worst_lights, brightest_lit);
   EXPECT_EQ(differing_fog, 0u);
   EXPECT_LE(worst_volumes, 1e-5);
+  EXPECT_LE(worst_lights, 1e-5);
+  EXPECT_GT(brightest_lit, 1.0);  // the lamps light the frame
 }
 
 // What the march cannot take is refused by name.

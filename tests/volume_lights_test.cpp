@@ -124,8 +124,8 @@ Errors compare(const std::vector<glm::dvec3>& want, const Get& got) {
 }
 
 struct Paths {
-  Errors scalar_double, scalar_float, kernel;
-  bool device = false;
+  Errors scalar_double, scalar_float, kernel, one_pixel;  // kernel: the device's own (CPU: 16 lanes)
+  bool device = false, cpu = false;                       // cpu: one_pixel ran (the one-pixel kernel)
 };
 
 Paths run_all(const LightFrame& f, const VolumeSettings& s, const std::vector<glm::dvec3>& want) {
@@ -143,8 +143,31 @@ Paths run_all(const LightFrame& f, const VolumeSettings& s, const std::vector<gl
     ColorImage k;
     VolumePass(*runtime()).apply(f.color, f.depth, k, f.params, f.scene, s);
     r.kernel = compare(want, [&](int x, int y) { return glm::dvec3(glm::vec3(k.pixel(x, y))); });
+    if (runtime()->is_cpu()) {
+      r.cpu = true;
+      CpuCodegen one_pixel;
+      one_pixel.one_pixel_per_work_item = true;
+      VolumePass(*runtime(), nullptr, one_pixel).apply(f.color, f.depth, k, f.params, f.scene, s);
+      r.one_pixel = compare(want, [&](int x, int y) { return glm::dvec3(glm::vec3(k.pixel(x, y))); });
+    }
   }
   return r;
+}
+
+// Prints a case's worst errors and checks them against its budgets.
+void check_paths(const char* name, const Paths& r, double budget_double, double budget_float) {
+  std::printf("  %-32s worst relative error: scalar<double> %.3g, scalar<float> %.3g, kernel %s%s (brightest %.3g)\n",
+              name, r.scalar_double.worst, r.scalar_float.worst,
+              r.device ? std::to_string(r.kernel.worst).c_str() : "(no device)",
+              r.cpu ? (", one pixel per work-item " + std::to_string(r.one_pixel.worst)).c_str() : "",
+              r.scalar_double.brightest);
+  EXPECT_TRUE(r.scalar_double.finite && r.scalar_float.finite && (!r.device || r.kernel.finite) &&
+              (!r.cpu || r.one_pixel.finite))
+      << name;
+  EXPECT_LE(r.scalar_double.worst, budget_double) << name;
+  EXPECT_LE(r.scalar_float.worst, budget_float) << name;
+  if (r.device) EXPECT_LE(r.kernel.worst, budget_float) << name;
+  if (r.cpu) EXPECT_LE(r.one_pixel.worst, budget_float) << name;
 }
 
 LocalLight point_at(glm::vec3 p, float intensity, float range, float radius = 0.05f) {
@@ -195,16 +218,7 @@ TEST(VolumeLights, MarchMatchesQuadrature) {
   for (const Case& c : cases()) {
     const LightFrame f = light_frame(c.media, c.lights);
     const std::vector<glm::dvec3> want = reference_image(f, 300);
-    const Paths r = run_all(f, light_settings(64), want);
-    std::printf("  %-32s worst relative error: scalar<double> %.3g, scalar<float> %.3g, kernel %s (brightest %.3g)\n",
-                c.name, r.scalar_double.worst, r.scalar_float.worst,
-                r.device ? std::to_string(r.kernel.worst).c_str() : "(no device)", r.scalar_double.brightest);
-    EXPECT_TRUE(r.scalar_double.finite && r.scalar_float.finite && (!r.device || r.kernel.finite)) << c.name;
-    EXPECT_LE(r.scalar_double.worst, c.budget_double) << c.name;
-    EXPECT_LE(r.scalar_float.worst, c.budget_float) << c.name;
-    if (r.device) {
-      EXPECT_LE(r.kernel.worst, c.budget_float) << c.name;
-    }
+    check_paths(c.name, run_all(f, light_settings(64), want), c.budget_double, c.budget_float);
   }
 }
 
@@ -240,16 +254,7 @@ TEST(VolumeLights, ExtremePlacementsAreFiniteAndMatchQuadrature) {
   for (const Case& c : extreme) {
     const LightFrame f = light_frame(c.media, c.lights);
     const std::vector<glm::dvec3> want = reference_image(f, 300);
-    const Paths r = run_all(f, light_settings(32), want);
-    std::printf("  %-32s worst relative error: scalar<double> %.3g, scalar<float> %.3g, kernel %s (brightest %.3g)\n",
-                c.name, r.scalar_double.worst, r.scalar_float.worst,
-                r.device ? std::to_string(r.kernel.worst).c_str() : "(no device)", r.scalar_double.brightest);
-    EXPECT_TRUE(r.scalar_double.finite && r.scalar_float.finite && (!r.device || r.kernel.finite)) << c.name;
-    EXPECT_LE(r.scalar_double.worst, c.budget_double) << c.name;
-    EXPECT_LE(r.scalar_float.worst, c.budget_float) << c.name;
-    if (r.device) {
-      EXPECT_LE(r.kernel.worst, c.budget_float) << c.name;
-    }
+    check_paths(c.name, run_all(f, light_settings(32), want), c.budget_double, c.budget_float);
   }
   // A medium of zero density scatters nothing: the lights leave the frame as it is.
   const LightFrame empty = light_frame({{{0.3, 0.2, 8.0}, 4.0, 0.0, {0.9, 0.8, 0.7}, 0.0}}, {on_ray, bright});
@@ -460,16 +465,7 @@ TEST(VolumeLights, HeightFogGlowsAsTheQuadratureSays) {
         want[std::size_t(y) * kW + x] = kScene * ref::transmittance(glm::dvec3(0.0), d, t_end, media) +
                                         ref::inscattered(glm::dvec3(0.0), d, t_end, media, f.scene.lights, 300);
       }
-    const Paths r = run_all(f, s, want);
-    std::printf("  %-36s worst relative error: scalar<double> %.3g, scalar<float> %.3g, kernel %s (brightest %.3g)\n",
-                c.name, r.scalar_double.worst, r.scalar_float.worst,
-                r.device ? std::to_string(r.kernel.worst).c_str() : "(no device)", r.scalar_double.brightest);
-    EXPECT_TRUE(r.scalar_double.finite && r.scalar_float.finite && (!r.device || r.kernel.finite)) << c.name;
-    EXPECT_LE(r.scalar_double.worst, 1e-2) << c.name;
-    EXPECT_LE(r.scalar_float.worst, 1e-2) << c.name;
-    if (r.device) {
-      EXPECT_LE(r.kernel.worst, 1e-2) << c.name;
-    }
+    check_paths(c.name, run_all(f, s, want), 1e-2, 1e-2);
   }
 }
 

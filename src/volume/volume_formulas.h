@@ -22,6 +22,7 @@ using glm::floor;
 using glm::length;
 using glm::normalize;
 using std::atan;
+using std::atan2;
 using std::ceil;
 using std::exp;
 using std::expm1;

@@ -579,8 +579,6 @@ int volume_march_lanes(const VolumeVariant& v, const DeviceTraits& device) {
   // kernels/volume_march.cl, docs/volumetric.md §Lanes on CPU devices: PoCL vectorises only across
   // work-items, which the march's loops prevent; the lanes instance has no image sampling.
   const bool buffer = v.noise_sampling == NoiseSampling::buffer || !(v.features & VOL_FEATURE_NOISE);
-  // The local lights run one pixel per work-item: the lanes instance does not carry them.
-  if (v.features & VOL_FEATURE_LIGHTS) return 1;
   return pixels_per_work_item(device) == 16 && buffer ? 16 : 1;
 }
 
@@ -615,8 +613,8 @@ std::string volume_march_options(const VolumeVariant& v, const DeviceTraits& dev
 // inlined into it (10); the stylized march's per-volume entries (7), or the physical walk's state
 // (15) and its per-volume entry and exit distances (2 x VOL_MAX_VOLUMES); with the marched height
 // fog its FOG_HP_* constants and its per-channel sums, their copies and the lanes' staging of
-// them (60); with local lights their spans along the ray and the volumes' extinctions of a segment
-// (2 x VOL_MAX_LIGHTS + VOL_MAX_VOLUMES). Twice that for what the
+// them (60); with local lights their constants along the ray and the volumes' extinctions of a
+// segment (VOL_LR_STRIDE x VOL_MAX_LIGHTS + VOL_MAX_VOLUMES). Twice that for what the
 // compiler keeps besides (spilled vectors, copies): PoCL 3.1's work-group functions hold 0.9-1.15x
 // the arrays per work-item (their stack frames: 6.4-6.8 KB physical, 1.7-2.2 KB stylized at 16
 // lanes).
@@ -624,7 +622,7 @@ std::size_t volume_march_private_bytes(const VolumeVariant& v, const DeviceTrait
   const std::size_t per_lane =
       13 + 10 + (v.integrator == VolumeIntegrator::stylized ? 7 : 15 + 2 * VOL_MAX_VOLUMES) +
       ((v.features & VOL_FEATURE_HEIGHT) ? FOG_HP_COUNT + 60 : 0) +  // the marched fog's constants and sums
-      ((v.features & VOL_FEATURE_LIGHTS) ? 2 * VOL_MAX_LIGHTS + VOL_MAX_VOLUMES : 0);  // light spans, extinctions
+      ((v.features & VOL_FEATURE_LIGHTS) ? VOL_LR_STRIDE * VOL_MAX_LIGHTS + VOL_MAX_VOLUMES : 0);  // lights' ray constants, extinctions
   return 2 * 4 * per_lane * std::size_t(volume_march_lanes(v, device));
 }
 
