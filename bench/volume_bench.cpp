@@ -617,7 +617,7 @@ BENCHMARK(BM_VolumeHeight)
     ->MinTime(0.5);
 BENCHMARK(BM_VolumeHeight)  // each point light's cost: the OpenCL pass and the OpenMP peer
     ->ArgNames({"path", "volumes", "rgb", "lights"})
-    ->ArgsProduct({{0, 3}, {1}, {0}, {1, 2, 4}})
+    ->ArgsProduct({{0, 3}, {0, 1}, {0}, {1, 2, 4}})
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);

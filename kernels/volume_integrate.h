@@ -364,44 +364,31 @@ VOL_FN VOL_REAL vol_mean_transmittance(VOL_REAL thick) {
   return thick > (VOL_REAL)0 ? -expm1(-thick) / thick : (VOL_REAL)1;
 }
 
-/* One piece [x0, x1] of a light's stretch of the segment starting at s0 (x = (t - t0) / sc, the
- * light's ray constants r; the piece starts at ray parameter ta and is len long), where `live`:
- * its inverse-square mass (int dt / (u^2 + sc^2) over it, exactly) times the mean transmittance
- * over it (whole_piece: the piece is the segment, whose mean `whole` the caller has) times the
- * scattering, the window and the cone at the piece's angular midpoint, added per channel to sum. */
-VOL_FN void vol_light_piece(VOL_REAL x0, VOL_REAL x1, VOL_REAL ta, VOL_REAL len, VOL_REAL mass, VOL_INT live,
-                            VOL_INT whole_piece, const VOL_REAL* r, VOL_GLOBAL const float* light, VOL_REAL s0,
-                            const VOL_REAL* sigma_t, const VOL_REAL* depth, int channels, const VOL_REAL* whole,
-                            const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols, int count,
-                            VOL_V3 fog_scatter, int features, VOL_REAL* sum) {
-  /* tan((phi0 + phi1) / 2) from x = tan(phi): (sin phi0 + sin phi1) / (cos phi0 + cos phi1), whose
-   * terms never cancel in the denominator (|phi| < pi / 2) */
-  const VOL_REAL r0 = sqrt((VOL_REAL)1 + x0 * x0), r1 = sqrt((VOL_REAL)1 + x1 * x1);
-  const VOL_REAL um = (x0 * r1 + x1 * r0) / (r0 + r1) * r[VOL_LR_SC]; /* t - t0 at the midpoint */
+/* One piece of a light's stretch of a segment, where `live`: its inverse-square mass (int du /
+ * (u^2 + sc^2) over it, exactly: its angle / sc) times its mean transmittance t[0..2] times the
+ * scattering, the window and the cone at its midpoint xm (x = u / sc, u = t - t0; r the light's ray
+ * constants), added per channel to sum. The distance to the light is taken only where a volume's
+ * phase or a cone needs it. */
+VOL_FN void vol_light_piece(VOL_REAL xm, VOL_REAL mass, VOL_INT live, const VOL_REAL* r, VOL_GLOBAL const float* light,
+                            const VOL_REAL* t, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols,
+                            int count, VOL_V3 fog_scatter, int features, VOL_REAL* sum) {
+  const VOL_REAL um = xm * r[VOL_LR_SC];
   const VOL_REAL d2 = um * um + r[VOL_LR_H2];
   const VOL_REAL w = (VOL_REAL)1 - d2 * VOL_PU(light, VOL_L_INV_RANGE2);
   const VOL_INT lit = live && w > (VOL_REAL)0;
   if (!VOL_ANY(lit)) return;
-  const VOL_REAL d = sqrt(d2);
-  /* toward the light: dot(dir, position - p) = t0 - t = -um */
-  const VOL_REAL cos_theta = d > (VOL_REAL)0 ? -um / d : (VOL_REAL)0;
-  VOL_REAL weight = w * w * mass;
-  if (features & VOL_FEATURE_SPOT) {
-    const VOL_REAL cos_axis =
-        d > (VOL_REAL)0 ? ((r[VOL_LR_T0] + um) * r[VOL_LR_AXIS_DIR] - r[VOL_LR_AXIS_AT]) / d : (VOL_REAL)1;
-    const VOL_REAL f = vol_saturate(cos_axis * VOL_PU(light, VOL_L_SPOT_SCALE) + VOL_PU(light, VOL_L_SPOT_OFFSET));
-    weight = weight * f * f;
+  VOL_REAL weight = w * w * mass, cos_theta = (VOL_REAL)0;
+  if (count > 0 || (features & VOL_FEATURE_SPOT)) {
+    const VOL_REAL d = sqrt(d2), inv_d = d > (VOL_REAL)0 ? (VOL_REAL)1 / d : (VOL_REAL)0;
+    /* toward the light: dot(dir, position - p) = t0 - t = -um */
+    cos_theta = -um * inv_d;
+    if (features & VOL_FEATURE_SPOT) {
+      const VOL_REAL cos_axis =
+          d > (VOL_REAL)0 ? ((r[VOL_LR_T0] + um) * r[VOL_LR_AXIS_DIR] - r[VOL_LR_AXIS_AT]) * inv_d : (VOL_REAL)1;
+      const VOL_REAL f = vol_saturate(cos_axis * VOL_PU(light, VOL_L_SPOT_SCALE) + VOL_PU(light, VOL_L_SPOT_OFFSET));
+      weight = weight * f * f;
+    }
   }
-  VOL_REAL t[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0};
-  const VOL_INT part = live && !whole_piece;
-  for (int c = 0; c < channels; ++c) {
-    t[c] = whole[c];
-    if (VOL_ANY(part))
-      t[c] = whole_piece ? t[c]
-                         : exp(-(depth[c] + sigma_t[c] * fmax(ta - s0, (VOL_REAL)0))) *
-                               vol_mean_transmittance(sigma_t[c] * len);
-  }
-  if (channels == 1) t[1] = t[2] = t[0];
   VOL_REAL s[3];
   vol_light_scatter(cos_theta, each, mask, vols, count, fog_scatter, s);
   for (int c = 0; c < 3; ++c) sum[c] = lit ? sum[c] + s[c] * t[c] * weight : sum[c];
@@ -411,50 +398,81 @@ VOL_FN void vol_light_piece(VOL_REAL x0, VOL_REAL x1, VOL_REAL ta, VOL_REAL len,
  * in it (constant), optical depth `depth` before it, each per channel (`channels` 3: the marched
  * fog's extinction differs per channel; 1: element 0 serves three); the ray's lights from
  * vol_light_rays (lr, ids, n). For each light whose stretch meets the segment, its part [a, b] is
- * cut into pieces of at most VOL_LIGHT_ANGLE_STEP as seen from the light (one, unless the segment
- * passes close to the light); on a piece [ua, ub] (u = t - t0, c = h^2 + radius^2) the inverse
- * square is integrated exactly, int du / (u^2 + c) = (angle subtended) / sqrt(c), and the
- * transmittance by its mean over the piece, T(ua) (1 - e^(-sigma_t (ub - ua))) / (sigma_t (ub - ua));
- * the window, the cone and the phase are taken at the piece's angular midpoint. A sample at the
- * light or a ray through it is finite: c >= radius^2 > 0. The angle between the pieces' ends is
- * atan2 of the tangent difference formula, exact for the segment's whole stretch and without the
- * cancellation of two angles near +-pi/2 (a far segment). */
+ * cut into pieces of equal angle, at most VOL_LIGHT_ANGLE_STEP, as seen from the light (one, unless
+ * the segment passes close to the light). On a piece [ua, ub] (u = t - t0, c = h^2 + radius^2)
+ * the inverse square is integrated exactly, int du / (u^2 + c) = (angle subtended) / sqrt(c), and
+ * the transmittance exactly by its mean over the piece, T(ua) (1 - e^(-sigma_t (ub - ua))) /
+ * (sigma_t (ub - ua)); the window, the cone and the phase are taken at the piece's angular
+ * midpoint. A sample at the light or a ray through it is finite: c >= radius^2 > 0.
+ * In x = u / sqrt(c) = tan(angle), no angle needs an atan or a tan of its own: the stretch's angle
+ * is atan2 of the tangent difference formula (exact, and without the cancellation of two angles
+ * near +-pi/2 of a far segment), one piece's midpoint is tan((phi0 + phi1) / 2) by the half-angle
+ * identity, and many pieces' ends and midpoints follow by the tangent addition formula from
+ * tan(piece angle / 2). */
 VOL_FN VOL_V3 vol_lights_segment(VOL_REAL s0, VOL_REAL s1, const VOL_REAL* sigma_t, const VOL_REAL* depth,
                                  int channels, const VOL_REAL* each, VOL_UINT mask, VOL_GLOBAL const float* vols,
                                  int count, VOL_V3 fog_scatter, VOL_GLOBAL const float* lights, const VOL_REAL* lr,
                                  const int* ids, int n, int features) {
-  VOL_REAL sum[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0}, whole[3];
+  VOL_REAL sum[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0}, before[3], whole[3];
   int have_whole = 0;
   for (int q = 0; q < n; ++q) {
     const VOL_REAL* r = lr + q * VOL_LR_STRIDE;
     const VOL_REAL a = fmax(s0, r[VOL_LR_IN]), b = fmin(s1, r[VOL_LR_OUT]);
     const VOL_INT on = b > a;
     if (!VOL_ANY(on)) continue; /* the segment is outside the light's range */
-    if (!have_whole) { /* the segment's mean transmittance, shared by the lights that cover it */
-      for (int c = 0; c < channels; ++c) whole[c] = exp(-depth[c]) * vol_mean_transmittance(sigma_t[c] * (s1 - s0));
+    if (!have_whole) { /* T before the segment and its mean over the segment, shared by the lights */
+      for (int c = 0; c < channels; ++c) {
+        before[c] = exp(-depth[c]);
+        whole[c] = before[c] * vol_mean_transmittance(sigma_t[c] * (s1 - s0));
+      }
       have_whole = 1;
     }
     VOL_GLOBAL const float* light = lights + ids[q] * VOL_L_STRIDE;
-    const VOL_REAL t0 = r[VOL_LR_T0], sc = r[VOL_LR_SC], inv_sc = r[VOL_LR_INV_SC];
-    const VOL_REAL xa = (a - t0) * inv_sc, xb = (b - t0) * inv_sc;
+    const VOL_REAL inv_sc = r[VOL_LR_INV_SC];
+    const VOL_REAL xa = (a - r[VOL_LR_T0]) * inv_sc, xb = (b - r[VOL_LR_T0]) * inv_sc;
     const VOL_REAL span = on ? atan2((b - a) * inv_sc, (VOL_REAL)1 + xa * xb) : (VOL_REAL)0;
     const VOL_REAL pieces = fmin((VOL_REAL)VOL_LIGHT_MAX_PIECES,
                                  fmax((VOL_REAL)1, ceil(span / (VOL_REAL)VOL_LIGHT_ANGLE_STEP)));
+    /* T at a, e^(-sigma_t (a - s0)) after `before`: 1 unless the stretch starts inside the segment */
+    VOL_REAL t[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0}, at_a[3];
+    const VOL_INT late = on && a > s0;
+    for (int c = 0; c < channels; ++c)
+      at_a[c] = VOL_ANY(late) ? (late ? before[c] * exp(-sigma_t[c] * (a - s0)) : before[c]) : before[c];
     VOL_REAL light_sum[3] = {(VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0};
     if (VOL_ANY(on && pieces > (VOL_REAL)1)) {
-      /* pieces of equal angle, their ends tan(phi_a + j * piece) kept in order within [xa, xb] */
-      const VOL_REAL piece = span / pieces, phi_a = atan(xa);
+      /* pieces of angle `piece`: from x0 = tan(phi), the end tan(phi + piece) = (x0 + k) / (1 - x0 k)
+       * and the midpoint (x0 + k2) / (1 - x0 k2), k = tan(piece), k2 = tan(piece / 2); both kept
+       * within the stretch. The transmittance at each piece's start carries over. */
+      const VOL_REAL piece = span / pieces, k2 = tan(piece * (VOL_REAL)0.5f);
+      const VOL_REAL k = (VOL_REAL)2 * k2 / ((VOL_REAL)1 - k2 * k2), sc = r[VOL_LR_SC];
       VOL_REAL x1 = xa;
       for (int j = 0; j < VOL_LIGHT_MAX_PIECES && VOL_ANY(on && (VOL_REAL)j < pieces); ++j) {
-        const VOL_REAL x0 = x1, next = (VOL_REAL)(j + 1);
-        x1 = next >= pieces ? xb : fmin(fmax(tan(phi_a + piece * next), x0), xb);
-        vol_light_piece(x0, x1, t0 + x0 * sc, (x1 - x0) * sc, piece * inv_sc, on && (VOL_REAL)j < pieces,
-                        (VOL_INT)0, r, light, s0, sigma_t, depth, channels, whole, each, mask, vols, count,
-                        fog_scatter, features, light_sum);
+        const VOL_INT live = on && (VOL_REAL)j < pieces;
+        const VOL_REAL x0 = x1;
+        x1 = (VOL_REAL)(j + 1) >= pieces ? xb : fmin(fmax((x0 + k) / ((VOL_REAL)1 - x0 * k), x0), xb);
+        const VOL_REAL xm = fmin(fmax((x0 + k2) / ((VOL_REAL)1 - x0 * k2), x0), x1);
+        const VOL_REAL len = (x1 - x0) * sc;
+        for (int c = 0; c < channels; ++c) {
+          const VOL_REAL thick = sigma_t[c] * len, fall = -expm1(-thick); /* 1 - e^-thick */
+          t[c] = at_a[c] * (thick > (VOL_REAL)0 ? fall / thick : (VOL_REAL)1);
+          at_a[c] = live ? at_a[c] - at_a[c] * fall : at_a[c];
+        }
+        if (channels == 1) t[1] = t[2] = t[0];
+        vol_light_piece(xm, piece * inv_sc, live, r, light, t, each, mask, vols, count, fog_scatter, features,
+                        light_sum);
       }
     } else {
-      vol_light_piece(xa, xb, a, b - a, span * inv_sc, on, a == s0 && b == s1, r, light, s0, sigma_t, depth,
-                      channels, whole, each, mask, vols, count, fog_scatter, features, light_sum);
+      /* one piece: tan((phi_a + phi_b) / 2) = (sin phi_a + sin phi_b) / (cos phi_a + cos phi_b) */
+      const VOL_REAL ra = sqrt((VOL_REAL)1 + xa * xa), rb = sqrt((VOL_REAL)1 + xb * xb);
+      const VOL_REAL xm = (xa * rb + xb * ra) / (ra + rb);
+      const VOL_INT whole_piece = !late && b == s1;
+      for (int c = 0; c < channels; ++c)
+        t[c] = VOL_ANY(on && !whole_piece)
+                   ? (whole_piece ? whole[c] : at_a[c] * vol_mean_transmittance(sigma_t[c] * (b - a)))
+                   : whole[c];
+      if (channels == 1) t[1] = t[2] = t[0];
+      vol_light_piece(xm, span * inv_sc, on, r, light, t, each, mask, vols, count, fog_scatter, features,
+                      light_sum);
     }
     sum[0] += VOL_PU(light, VOL_L_RADIANCE) * light_sum[0];
     sum[1] += VOL_PU(light, VOL_L_RADIANCE + 1) * light_sum[1];

@@ -166,8 +166,12 @@ void check_paths(const char* name, const Paths& r, double budget_double, double 
       << name;
   EXPECT_LE(r.scalar_double.worst, budget_double) << name;
   EXPECT_LE(r.scalar_float.worst, budget_float) << name;
-  if (r.device) EXPECT_LE(r.kernel.worst, budget_float) << name;
-  if (r.cpu) EXPECT_LE(r.one_pixel.worst, budget_float) << name;
+  if (r.device) {
+    EXPECT_LE(r.kernel.worst, budget_float) << name;
+  }
+  if (r.cpu) {
+    EXPECT_LE(r.one_pixel.worst, budget_float) << name;
+  }
 }
 
 LocalLight point_at(glm::vec3 p, float intensity, float range, float radius = 0.05f) {
