@@ -18,7 +18,7 @@
  *                    (docs/DESIGN.md §6.5); with VOL_FEATURE_HEIGHT_RGB the target holds a
  *                    coverage per channel (volume_composite.h's layout)
  *   VOL_FEATURE_LIGHTS / VOL_FEATURE_SPOT in VOL_FEATURES: local lights, read after the volumes
- *                    (VOL_F_LIGHT_OFFSET); one pixel per work-item (the lanes do not carry them)
+ *                    (VOL_F_LIGHT_OFFSET), on both instances
  *
  * Why 16 pixels per work-item on CPUs (docs/volumetric.md §Lanes on CPU devices): PoCL vectorises
  * only across work-items, and the march's per-ray loops and branches keep it out, so each core
