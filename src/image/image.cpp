@@ -12,6 +12,7 @@
 #include <Imath/half.h>
 #if defined(__linux__)
 #include <sys/mman.h>
+#include <sys/sysinfo.h>
 #endif
 
 #include "fogcl/error.h"
@@ -37,8 +38,22 @@ void check_size(const char* what, int width, int height) {
 
 std::string size_text(int width, int height) { return std::to_string(width) + "x" + std::to_string(height); }
 
+// The machine's memory and swap in bytes (0: unknown). An image larger than that can never be
+// backed: where Linux overcommits memory, its allocation would succeed and the process be killed
+// when the pages are touched, so it is refused first.
+std::size_t machine_memory_bytes() {
+#if defined(__linux__)
+  struct sysinfo info {};
+  if (sysinfo(&info) == 0) return (std::size_t(info.totalram) + std::size_t(info.totalswap)) * info.mem_unit;
+#endif
+  return 0;
+}
+
 // Page-aligned storage for an image, or fogcl::Error naming the image and the bytes it needed.
 detail::AlignedBytes image_storage(const std::string& what, std::size_t bytes) {
+  if (const std::size_t machine = machine_memory_bytes(); machine != 0 && bytes > machine)
+    throw OutOfMemory(what + ": cannot allocate " + std::to_string(bytes) + " bytes (out of host memory: more than " +
+                      "this machine's " + std::to_string(machine) + " bytes of memory and swap)");
   try {
     return detail::AlignedBytes(bytes);
   } catch (const std::bad_alloc&) {
