@@ -358,21 +358,31 @@ def volume_budget(root):
 
 
 SHAFTS_CSV = "volume-report-shafts-2core/volume-report.csv"
+LAMPS_CSV = "volume-report-lamps-2core/volume-report.csv"
+
+
+def _marched_scene_table(root, csv_name, scene, date, steps_list):
+    """One marched-fog scene of `fogcl report --volumetric` (physical rows): steps x resolution."""
+    with open(root / RESULTS / csv_name, newline="") as f:
+        rows = list(csv.DictReader(f))
+    out = []
+    for steps in steps_list:
+        for res in ("full", "half", "quarter"):
+            r = _report_rows(rows, "physical", steps, res, scene)[0]
+            out.append([str(steps), res, f"{float(r['time_ms']):.1f}", g3(r["max_abs_err"]), g3(r["p999_abs_err"]),
+                        f"{float(r['pct_8bit_off']):.1f}", r["nonfinite"]])
+    note = (f"The `{scene}` scene, physical, 160×90, RGBA32F, noise buffer, depth-aware below full resolution; "
+            f"2-core EPYC VM, PoCL 3.1, {date}, {src(csv_name)} (all {len(rows)} rows).\n\n")
+    header = ["steps", "resolution", "ms", "max", "p99.9", "% 8-bit off", "NaN/Inf"]
+    return note + table(header, out, ["--:", "---"] + ["--:"] * 5)
 
 
 def volume_shafts(root):
-    with open(root / RESULTS / SHAFTS_CSV, newline="") as f:
-        rows = list(csv.DictReader(f))
-    out = []
-    for steps in (8, 16, 32, 64, 128, 256):
-        for res in ("full", "half", "quarter"):
-            r = _report_rows(rows, "physical", steps, res, "shafts")[0]
-            out.append([str(steps), res, f"{float(r['time_ms']):.1f}", g3(r["max_abs_err"]), g3(r["p999_abs_err"]),
-                        f"{float(r['pct_8bit_off']):.1f}", r["nonfinite"]])
-    note = (f"The `shafts` scene, physical, 160×90, RGBA32F, noise buffer, depth-aware below full resolution; "
-            f"2-core EPYC VM, PoCL 3.1, 2026-11-29, {src(SHAFTS_CSV)} (all {len(rows)} rows).\n\n")
-    header = ["steps", "resolution", "ms", "max", "p99.9", "% 8-bit off", "NaN/Inf"]
-    return note + table(header, out, ["--:", "---"] + ["--:"] * 5)
+    return _marched_scene_table(root, SHAFTS_CSV, "shafts", "2026-11-29", (8, 16, 32, 64, 128, 256))
+
+
+def volume_lamps(root):
+    return _marched_scene_table(root, LAMPS_CSV, "lamps", "2026-11-29", (8, 16, 32, 64, 128, 256))
 
 
 def readme_speed(root):
@@ -525,6 +535,7 @@ RENDERERS = {
     "volume-stiff": volume_stiff,
     "volume-budget": volume_budget,
     "volume-shafts": volume_shafts,
+    "volume-lamps": volume_lamps,
     "readme-speed": readme_speed,
     "readme-accuracy": readme_accuracy,
 }

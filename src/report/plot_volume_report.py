@@ -30,7 +30,8 @@ def label_of(r):
 panels = scenes + (["dense: riemann vs physical"] if any(r["integrator"] == "riemann" for r in rows) else [])
 cols = min(3, len(panels))
 nrows = (len(panels) + cols - 1) // cols
-fig, axes = plt.subplots(nrows, cols, figsize=(5.4 * cols, 4.3 * nrows), squeeze=False)
+# One panel (a report of one scene) is drawn wider, so that the title and the legend fit.
+fig, axes = plt.subplots(nrows, cols, figsize=(max(5.4 * cols, 8.6), 4.3 * nrows), squeeze=False)
 legend = {}
 for i, scene in enumerate(scenes):
     ax = axes[i // cols][i % cols]
@@ -111,7 +112,8 @@ if len(panels) < nrows * cols:
     ax.grid(True, which="both", alpha=0.3)
 for j in range(len(panels), nrows * cols):
     axes[j // cols][j % cols].axis("off")
-fig.legend(list(legend.values()), list(legend.keys()), loc="lower center", ncol=4, fontsize=8, frameon=False)
+fig.legend(list(legend.values()), list(legend.keys()), loc="lower center", ncol=4 if cols > 1 else 3, fontsize=8,
+           frameon=False)
 fig.suptitle("fogcl volumetric pass: error against run time (filled: rgba32f, hollow: rgba16f)")
-fig.tight_layout(rect=(0, 0.07, 1, 0.96))
+fig.tight_layout(rect=(0, 0.07 if nrows > 1 or cols > 1 else 0.14, 1, 0.96))
 save_png(fig, "volume-report.png", 100)
