@@ -161,6 +161,12 @@ TEST(VolumeReport, LampErrorShrinksWithSteps) {
   EXPECT_GT(coarse->max_abs_err, 0.0);
   EXPECT_LT(fine->max_abs_err, 0.5 * coarse->max_abs_err);
   EXPECT_LT(fine->p999_abs_err, 0.5 * coarse->p999_abs_err);
+  // A report of one scene is one panel, drawn 8.6 inches wide so that its title and legend fit.
+  if (!require_matplotlib()) return;
+  const std::string dir = fresh_dir("volume-report-lamps");
+  write_volume_report_csv(r, dir + "/volume-report.csv");
+  plot_volume_report(dir);
+  expect_plot(dir + "/volume-report.png", 1, 8.6, 4.3, 100);
 }
 
 TEST(VolumeReport, PhysicalErrorShrinksWithStepsOnTheDemo) {
