@@ -342,6 +342,16 @@ TEST(VolumeErrorBudget, TheMarchedHeightFogIsMeasuredWithTheShaftScene) {
   EXPECT_NE(b.reason.find("with the marched height fog"), std::string::npos) << b.reason;
 }
 
+// fogcl apply's camera flags for the demo's view (DemoView), exact to float.
+std::string demo_pose_flags() {
+  const DemoView view;
+  const glm::vec3 fwd = view.target - view.eye;
+  char pose[256];
+  std::snprintf(pose, sizeof pose, " --eye %.9g,%.9g,%.9g --forward %.9g,%.9g,%.9g --up 0,1,0", view.eye.x, view.eye.y,
+                view.eye.z, fwd.x, fwd.y, fwd.z);
+  return pose;
+}
+
 // fogcl apply --volumes --max-error: reads the cache the API wrote, prints the choice, runs it.
 TEST(VolumeErrorBudgetCli, MaxErrorPicksTheVariantAndExplicitFlagsConflict) {
   FOGCL_REQUIRE_DEVICE();
@@ -355,11 +365,7 @@ TEST(VolumeErrorBudgetCli, MaxErrorPicksTheVariantAndExplicitFlagsConflict) {
   VolumeSettings base;  // stylized, as the CLI's default
   const VolumeQualityChoice measured =
       choose_volume_quality(*runtime(), base, storage, 1e9, small_budget(dir + "/xdg/fogcl"));
-  const DemoView view;
-  const glm::vec3 fwd = view.target - view.eye;
-  char pose[256];
-  std::snprintf(pose, sizeof pose, " --eye %.9g,%.9g,%.9g --forward %.9g,%.9g,%.9g --up 0,1,0", view.eye.x, view.eye.y,
-                view.eye.z, fwd.x, fwd.y, fwd.z);
+  const std::string pose = demo_pose_flags();
   const std::string common = "apply --color " + dir + "/scene.exr --depth " + dir +
                              "/scene-depth.exr --near 0.3 --far 1000 --fov 60 --volumes " + dir + "/volumes.json" +
                              pose + " --device " + cli_device();
@@ -407,11 +413,7 @@ TEST(VolumeErrorBudgetCli, MaxErrorPicksTheMarchedHeightFogsVariant) {
   const ColorFormat storage = read_exr_color(dir + "/scene.exr").format();
   const VolumeQualityChoice measured =
       choose_volume_quality(*runtime(), base, storage, 1e9, small_budget(dir + "/xdg/fogcl"));
-  const DemoView view;
-  const glm::vec3 fwd = view.target - view.eye;
-  char pose[256];
-  std::snprintf(pose, sizeof pose, " --eye %.9g,%.9g,%.9g --forward %.9g,%.9g,%.9g --up 0,1,0", view.eye.x, view.eye.y,
-                view.eye.z, fwd.x, fwd.y, fwd.z);
+  const std::string pose = demo_pose_flags();
   const std::string cmd = "apply --color " + dir + "/scene.exr --depth " + dir +
                           "/scene-depth.exr --near 0.3 --far 1000 --fov 60 --mode height --density 0.05 "
                           "--height-falloff 0.3 --height-volumetric --verbose --max-error 1e9" +
