@@ -115,11 +115,8 @@ py::array apply(const py::array& color, const py::array& depth, const py::object
   frame.out = o_view;
   frame.camera = file_camera ? &*file_camera : nullptr;
   frame.name = "fogcl.apply";
-  // The options as typed, and the document given, pick the devices to reuse.
-  std::string volumes_text;
-  std::string key;
-  for (const std::string& a : option_args(options, &volumes_text)) key += a + '\0';
-  key += volumes_text;
+  // The options as typed, the document given and the files named pick the devices to reuse.
+  const std::string key = options_key(options, o);
 
   std::unique_ptr<cli::MemoryFogger> fogger;
   PassStats before;

@@ -112,12 +112,35 @@ auto library_call(Fn&& fn) -> decltype(fn()) {
   return fn();
 }
 
+// Runs fn, the options' rules as Python sees them: a library rule (fogcl::Error, or
+// python/options.h's ValueError) becomes ValueError naming `who` once; Python's own errors, memory
+// and OpenCL errors pass as they are.
+template <class Fn>
+auto option_errors(const std::string& who, Fn&& fn) -> decltype(fn()) {
+  try {
+    return fn();
+  } catch (const py::error_already_set&) {
+    throw;  // Python's own (a volumes= document json cannot write, an interrupt)
+  } catch (const OutOfMemory&) {
+    throw;
+  } catch (const ClError&) {
+    throw;
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    throw py::value_error(what.rfind(who, 0) == 0 ? what : who + ": " + what);  // named once
+  }
+}
+
 // What a frame's keyword options make for the passes: fogcl.apply's words (python/options.h),
 // resolved as `fogcl apply` resolves them for a width x height frame with no file behind it.
 struct FrameSetup {
   CameraParams camera;
   FogSettings settings;                        // the deferred fog (FogPass)
-  std::unique_ptr<cli::VolumeStage> volumes;   // volumes= or height_volumetric=True (VolumePass)
+  cli::VolumeCliOptions volume_options;        // for a volume stage (VolumePass)
+  std::unique_ptr<cli::VolumeStage> volumes;   // with_volumes: volumes= or height_volumetric=True
+  std::optional<CameraPose> pose;              // the volumes' pose when it comes with the frame
+  std::string pose_from;
+  std::string key;                             // python/options.h's options_key, camera= aside
 };
 
 // fogcl.apply's options that choose a device or measure one: a pass runs on its context's.
@@ -140,7 +163,7 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
       file_camera = given.cast<ExrCamera>();
     }
   }
-  try {
+  return option_errors(who, [&] {
     const cli::ApplyOptions o = apply_options(flags);
     // The frame has no file behind it: its camera is the options' and camera='s.
     const cli::FrameCamera camera =
@@ -148,21 +171,16 @@ FrameSetup frame_setup(const py::kwargs& kwargs, int width, int height, const st
     FrameSetup s;
     s.camera = camera.params;
     s.settings = o.settings;
+    s.volume_options = o.volumes;
+    s.pose = camera.pose;
+    s.pose_from = camera.pose_from;
+    s.key = std::to_string(width) + "x" + std::to_string(height) + '\0' + options_key(flags, o);
     if (with_volumes) {
       s.volumes = cli::VolumeStage::create(o.volumes, nullptr);
       if (s.volumes) s.volumes->set_frame_pose(camera.pose, camera.pose_from);
     }
     return s;
-  } catch (const py::error_already_set&) {
-    throw;  // Python's own (a volumes= document json cannot write, an interrupt)
-  } catch (const OutOfMemory&) {
-    throw;
-  } catch (const ClError&) {
-    throw;
-  } catch (const std::exception& e) {  // the options' rules (fogcl::Error, or python/options.h's ValueError)
-    const std::string what = e.what();
-    throw py::value_error(what.rfind(who, 0) == 0 ? what : who + ": " + what);  // named once
-  }
+  });
 }
 
 // An enqueue's arguments, checked before the pass runs.
@@ -283,28 +301,63 @@ class PyVolumePass : public PassObject<VolumePass> {
   py::object enqueue(const py::object& color, const py::object& depth, const py::object& out, int width, int height,
                      const std::string& format, const py::object& queue, const py::object& wait_for,
                      const py::kwargs& options) {
-    const FrameCall c = frame_call(color, depth, out, width, height, format, queue, wait_for, options, true);
-    const cli::VolumeStage& stage = volumes_of(c.setup, "enqueue");
-    const VolumeScene scene = stage.scene_for(-1);
-    return adopt_event(locked("enqueue", [&](VolumePass& pass, PassHandles& handles) {
-      // The light's depth map, read from its file by the options, goes to the device with this
-      // frame (copied at the buffer's creation; OpenCL keeps the buffer until the march has read it).
-      std::optional<cl::Buffer> map;
-      std::optional<ShadowMapBuffer> shadow;
-      if (const ShadowMap* s = stage.shadow()) {
-        map = with_cl_errors([&] {
-          return cl::Buffer(handles.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                            depth_buffer_bytes(s->depth.width(), s->depth.height()),
-                            const_cast<float*>(s->depth.data()));
-        });
-        shadow = ShadowMapBuffer{(*map)(), s->depth.width(), s->depth.height(), s->params};
-      }
-      return pass.enqueue(c.queue(), c.buffers, c.setup.camera, scene, stage.settings(), shadow ? &*shadow : nullptr,
-                          c.waits);
+    // The frame's camera and buffers every call; the volume stage (VOLUMES.json, the shadow map
+    // and its device copy) only when the options or the files they name have changed.
+    FrameCall c = frame_call(color, depth, out, width, height, format, queue, wait_for, options, false);
+    std::shared_ptr<const Stage> stage;
+    {
+      std::lock_guard<std::mutex> lock(stage_m_);
+      if (stage_ && stage_->key == c.setup.key) stage = stage_;
+    }
+    if (!stage) stage = make_stage(c.setup, c.handles);
+    VolumeScene scene;
+    {
+      std::lock_guard<std::mutex> lock(stage_m_);  // the pose is the stage's state: one frame at a time
+      stage->volumes->set_frame_pose(c.setup.pose, c.setup.pose_from);
+      scene = stage->volumes->scene_for(-1);
+    }
+    return adopt_event(locked("enqueue", [&](VolumePass& pass, PassHandles&) {
+      return pass.enqueue(c.queue(), c.buffers, c.setup.camera, scene, stage->volumes->settings(),
+                          stage->shadow ? &*stage->shadow : nullptr, c.waits);
     }));
   }
 
  private:
+  // The volume stage of one set of options, and the light's depth map on the device (read-only:
+  // frames in flight share it; each enqueue keeps the stage alive until it returns, and OpenCL
+  // keeps the buffer until the march has read it).
+  struct Stage {
+    std::string key;
+    std::unique_ptr<cli::VolumeStage> volumes;
+    std::optional<cl::Buffer> map;
+    std::optional<ShadowMapBuffer> shadow;
+  };
+
+  std::shared_ptr<const Stage> make_stage(FrameSetup& setup, const PassHandles& handles) {
+    const std::string who = this->who() + ".enqueue";
+    setup.volumes = option_errors(who, [&] { return cli::VolumeStage::create(setup.volume_options, nullptr); });
+    volumes_of(setup, "enqueue");
+    auto stage = std::make_shared<Stage>();
+    stage->key = setup.key;
+    stage->volumes = std::move(setup.volumes);
+    if (const ShadowMap* s = stage->volumes->shadow()) {
+      stage->map = library_call([&] {
+        return with_cl_errors([&] {
+          return cl::Buffer(handles.context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                            depth_buffer_bytes(s->depth.width(), s->depth.height()),
+                            const_cast<float*>(s->depth.data()));
+        });
+      });
+      stage->shadow = ShadowMapBuffer{(*stage->map)(), s->depth.width(), s->depth.height(), s->params};
+    }
+    std::lock_guard<std::mutex> lock(stage_m_);
+    stage_ = stage;
+    return stage;
+  }
+
+  std::mutex stage_m_;
+  std::shared_ptr<Stage> stage_;  // the last options' (one entry: a renderer's frames share theirs)
+
   const cli::VolumeStage& volumes_of(const FrameSetup& setup, const char* call) const {
     if (!setup.volumes)
       throw py::value_error(who() + "." + call + ": no volumes: give volumes= (a VOLUMES.json path or its document) "

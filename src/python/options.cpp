@@ -1,6 +1,7 @@
 #include "python/options.h"
 
 #include <cstdlib>
+#include <filesystem>
 
 #include "cli/apply_flags.h"
 #include "cli/flag_values.h"
@@ -81,6 +82,22 @@ cli::ApplyOptions apply_options(const py::dict& options) {
   } catch (const Error& e) {  // UsageError too: both are the caller's options
     throw py::value_error(e.what());
   }
+}
+
+std::string options_key(const py::dict& options, const cli::ApplyOptions& o) {
+  std::string volumes_text, key;
+  for (const std::string& a : option_args(options, &volumes_text)) key += a + '\0';
+  key += volumes_text;
+  for (const std::string& file : {o.volumes.volumes_path, o.volumes.shadow_map_path}) {
+    if (file.empty() || (file == o.volumes.volumes_path && !o.volumes.volumes_text.empty())) continue;
+    std::error_code size_error, time_error;
+    const auto size = std::filesystem::file_size(file, size_error);
+    const auto time = std::filesystem::last_write_time(file, time_error);
+    key += '\0' + file + (size_error || time_error ? std::string(" (unreadable)")
+                                                    : " " + std::to_string(size) + " " +
+                                                          std::to_string(time.time_since_epoch().count()));
+  }
+  return key;
 }
 
 }  // namespace fogcl::python

@@ -22,4 +22,10 @@ std::vector<std::string> option_args(const pybind11::dict& options, std::string*
 // (no file flags). Throws pybind11::value_error with the command line's message.
 cli::ApplyOptions apply_options(const pybind11::dict& options);
 
+// What decides the passes `options` make (o: those options parsed): the flags as typed, the
+// volumes= document, and the size and time of the files they name (VOLUMES.json, the shadow
+// map), so that what is kept for the next frames (fogcl.apply's devices, a VolumePass's stage)
+// is not reused once a file is rewritten.
+std::string options_key(const pybind11::dict& options, const cli::ApplyOptions& o);
+
 }  // namespace fogcl::python

@@ -173,6 +173,16 @@ def test_volume_pass_with_a_shadow_map(ctx, queue, tmp_path):
     print(f"  the shadow changes the frame by up to {np.abs(want - unshadowed).max():.3g}")
     assert np.any(got != unshadowed)
 
+    # The next frames reuse the map on the device while its file is unchanged, and read it again
+    # once it is rewritten (another size, so its size and time both change).
+    event = volumes.enqueue(c, d, o, width=width, height=height, **options)
+    assert report_bits("VolumePass, the same map again", from_device(queue, o, color, wait_for=[event]), want) == 0
+    fogcl.write_exr_depth(str(tmp_path / "shadow.exr"), np.ones((30, 26), np.float32))  # nothing in shadow
+    rewritten = fogcl.apply(color, depth, **options)
+    assert np.any(rewritten != want), "the new map would not show"
+    event = volumes.enqueue(c, d, o, width=width, height=height, **options)
+    assert report_bits("VolumePass, the map rewritten", from_device(queue, o, color, wait_for=[event]), rewritten) == 0
+
 
 CHAINED_CASES = {
     "volumes": lambda rng: dict(VOLUME_OPTIONS, volumes=volumes_document(rng, 2), mode="exp2", density=0.05),
