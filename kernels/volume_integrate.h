@@ -481,6 +481,33 @@ VOL_FN VOL_V3 vol_lights_segment(VOL_REAL s0, VOL_REAL s1, const VOL_REAL* sigma
   return VOL_MAKE3(sum[0], sum[1], sum[2]);
 }
 
+/* The local lights of one segment of the march [s0, s1] (vol_physical's and the lanes'): the
+ * extinction there is the volumes' sigma_t (where > 0) plus, where `fogged`, the marched fog's
+ * added optical depth over the segment per unit length (fog_ext - ext_before, per channel), and
+ * the fog scatters its in-scattering depth per unit length (fog_in - in_before; channel 0 serves
+ * three where fog_rgb is 0); the optical depth in front is the volumes' depth plus ext_before. */
+VOL_FN VOL_V3 vol_segment_lights(VOL_REAL s0, VOL_REAL s1, VOL_REAL sigma_t, VOL_REAL depth, VOL_INT fogged,
+                                 const VOL_REAL* ext_before, const VOL_REAL* fog_ext, const VOL_REAL* in_before,
+                                 const VOL_REAL* fog_in, int fog_rgb, int channels, const VOL_REAL* each,
+                                 VOL_UINT mask, VOL_GLOBAL const float* vols, int count,
+                                 VOL_GLOBAL const float* lights, const VOL_REAL* lr, const int* ids, int n,
+                                 int features) {
+  const VOL_REAL seg = s1 - s0;
+  const VOL_INT thick = fogged && seg > (VOL_REAL)0;
+  VOL_REAL fog_s[3], sigma_all[3], depth_all[3];
+  for (int c = 0; c < 3; ++c) {
+    const int f = fog_rgb ? c : 0;
+    fog_s[c] = thick ? (fog_in[f] - in_before[f]) / seg : (VOL_REAL)0;
+  }
+  for (int c = 0; c < channels; ++c) {
+    sigma_all[c] = (sigma_t > (VOL_REAL)0 ? sigma_t : (VOL_REAL)0) +
+                   (thick ? (fog_ext[c] - ext_before[c]) / seg : (VOL_REAL)0);
+    depth_all[c] = depth + ext_before[c];
+  }
+  return vol_lights_segment(s0, s1, sigma_all, depth_all, channels, each, mask, vols, count,
+                            VOL_MAKE3(fog_s[0], fog_s[1], fog_s[2]), lights, lr, ids, n, features);
+}
+
 #ifndef VOL_LANE_INSTANCE
 
 /* The marched height fog's stretch of a ray (docs/DESIGN.md §6.5): §6.2's [s0, s1] in distance
@@ -625,7 +652,6 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
   const int ray_lights = n_lights > 0 ? vol_light_rays(origin, dir, fmin(start, (VOL_REAL)0), t_scene, lights,
                                                        n_lights, features, lr, light_ids)
                                      : 0;
-  const VOL_V3 no_fog = VOL_MAKE3((VOL_REAL)0, (VOL_REAL)0, (VOL_REAL)0);
   /* The fog's extinction per channel (VOL_FEATURE_HEIGHT_RGB) dims the volumes' light per channel. */
   const int channels = (features & VOL_FEATURE_HEIGHT_RGB) ? 3 : 1;
   VOL_REAL phase[VOL_MAX_VOLUMES];
@@ -651,63 +677,32 @@ VOL_FN VOL_V4 vol_physical(VOL_V3 origin, VOL_V3 dir, VOL_REAL t_scene, VOL_REAL
         VOL_V3 source;
         const VOL_REAL sigma_t = vol_physical_sample(p, t, phase, lit, mask, vols, count, frame, noise,
                                                      noise_size, features, &source, each);
-        if (height && (mask & fog_bit)) {
-          /* Extinctions add: the volumes' light shares the segment with the fog's (§6.5). */
-          const VOL_REAL other = sigma_t > (VOL_REAL)0 ? sigma_t * seg : (VOL_REAL)0;
-          const VOL_REAL ext_before[3] = {fog_ext[0], fog_ext[1], fog_ext[2]};
-          const VOL_REAL in_before[3] = {fog_in[0], fog_in[1], fog_in[2]};
-          vol_height_segment(s0, s1, s_origin, wy, d0, lit, other, depth, hp, hf, fog_ext, fog_in, fog_sun_depth,
-                             fog_amb, fog_sun);
-          if (ray_lights > 0 && seg > (VOL_REAL)0) {
-            /* The fog's scattering coefficient: its in-scattering depth over the segment per unit
-             * length (one channel without FOG_HF_RGB); extinctions add as for the main light. */
-            const int rgb = (hf & FOG_HF_RGB) != 0;
-            const VOL_V3 fog_scatter = VOL_MAKE3(fog_in[0] - in_before[0], rgb ? fog_in[1] - in_before[1] : fog_in[0] - in_before[0],
-                                                 rgb ? fog_in[2] - in_before[2] : fog_in[0] - in_before[0]) / seg;
-            VOL_REAL sigma_all[3], depth_all[3];
-            for (int c = 0; c < channels; ++c) {
-              sigma_all[c] = (sigma_t > (VOL_REAL)0 ? sigma_t : (VOL_REAL)0) + (fog_ext[c] - ext_before[c]) / seg;
-              depth_all[c] = depth + ext_before[c];
-            }
-            const VOL_V3 l = vol_lights_segment(s0, s1, sigma_all, depth_all, channels, each, mask, vols, count,
-                                                fog_scatter, lights, lr, light_ids, ray_lights, features);
-            i_r += l.x;
-            i_g += l.y;
-            i_b += l.z;
-          }
-          if (!(sigma_t > (VOL_REAL)0)) continue;
-          VOL_REAL scatter[3];
-          for (int c = 0; c < channels; ++c)
-            scatter[c] = vol_segment_weight(sigma_t + (fog_ext[c] - ext_before[c]) / seg, seg, depth + ext_before[c],
-                                            riemann);
-          if (channels == 1) scatter[1] = scatter[2] = scatter[0];
-          i_r += source.x * scatter[0];
-          i_g += source.y * scatter[1];
-          i_b += source.z * scatter[2];
-          depth += sigma_t * seg;
-          continue;
-        }
-        if (!(sigma_t > (VOL_REAL)0)) continue;
-        if (ray_lights > 0) {
-          VOL_REAL sig3[3], depth3[3];
-          for (int c = 0; c < channels; ++c) sig3[c] = sigma_t, depth3[c] = height ? depth + fog_ext[c] : depth;
-          const VOL_V3 l = vol_lights_segment(s0, s1, sig3, depth3, channels, each, mask, vols, count, no_fog, lights,
-                                              lr, light_ids, ray_lights, features);
+        /* The marched fog's segment (§6.5), where the segment has the fog: extinctions add, the
+         * volumes' light shares the segment with the fog's. ext_before, in_before: the fog's sums
+         * in front of the segment (its sums as they are where it has none). */
+        const int fogged = height && (mask & fog_bit);
+        const VOL_REAL ext_before[3] = {fog_ext[0], fog_ext[1], fog_ext[2]};
+        const VOL_REAL in_before[3] = {fog_in[0], fog_in[1], fog_in[2]};
+        if (fogged)
+          vol_height_segment(s0, s1, s_origin, wy, d0, lit, sigma_t > (VOL_REAL)0 ? sigma_t * seg : (VOL_REAL)0, depth,
+                             hp, hf, fog_ext, fog_in, fog_sun_depth, fog_amb, fog_sun);
+        if (ray_lights > 0 && (sigma_t > (VOL_REAL)0 || (fogged && seg > (VOL_REAL)0))) {
+          const VOL_V3 l = vol_segment_lights(s0, s1, sigma_t, depth, fogged, ext_before, fog_ext, in_before, fog_in,
+                                              (hf & FOG_HF_RGB) != 0, channels, each, mask, vols, count, lights, lr,
+                                              light_ids, ray_lights, features);
           i_r += l.x;
           i_g += l.y;
           i_b += l.z;
         }
-        if (height && channels == 3) {
-          i_r += source.x * vol_segment_weight(sigma_t, seg, depth + fog_ext[0], riemann);
-          i_g += source.y * vol_segment_weight(sigma_t, seg, depth + fog_ext[1], riemann);
-          i_b += source.z * vol_segment_weight(sigma_t, seg, depth + fog_ext[2], riemann);
-          depth += sigma_t * seg;
-          continue;
-        }
-        const VOL_REAL scatter = vol_segment_weight(sigma_t, seg, height ? depth + fog_ext[0] : depth, riemann);
-        i_r += source.x * scatter;
-        i_g += source.y * scatter;
-        i_b += source.z * scatter;
+        if (!(sigma_t > (VOL_REAL)0)) continue;
+        VOL_REAL scatter[3];
+        for (int c = 0; c < channels; ++c)
+          scatter[c] = vol_segment_weight(fogged ? sigma_t + (fog_ext[c] - ext_before[c]) / seg : sigma_t, seg,
+                                          depth + ext_before[c], riemann);
+        if (channels == 1) scatter[1] = scatter[2] = scatter[0];
+        i_r += source.x * scatter[0];
+        i_g += source.y * scatter[1];
+        i_b += source.z * scatter[2];
         depth += sigma_t * seg;
       }
     }

@@ -407,24 +407,10 @@ kernel void volume_march(global const float* depth, global const float* frame, g
       }
     }
 #if VOL_FEATURES & VOL_FEATURE_LIGHTS
-    if (ray_lights > 0) {
-      /* vol_physical's lights of a segment: the fog's scattering coefficient where the lane's
-       * segment has the fog, the extinctions added; lanes without a medium scatter nothing. */
-      const int16 has_length = seg > 0.0f;
-      const float16 inv_seg = has_length ? 1.0f / seg : 0.0f;
-      float16 fog_s[3];
-      for (int c = 0; c < 3; ++c) {
-        const int fc = fog_channels == 3 ? c : 0; /* grey fog: channel 0 serves three */
-        fog_s[c] = fogged ? (fog_in[fc] - in_before[fc]) * inv_seg : 0.0f;
-      }
-      float16 sigma_all[3], depth_all[3];
-      for (int c = 0; c < channels; ++c) {
-        sigma_all[c] = (adds ? sigma_t : 0.0f) + (fogged ? (fog_ext[c] - ext_before[c]) * inv_seg : 0.0f);
-        depth_all[c] = optical + ext_before[c];
-      }
-      const vol_float3x16 l = vol_lights_segment(s0, s1, sigma_all, depth_all, channels, each, volumes_here, volumes,
-                                                 count, vol_make3_x16(fog_s[0], fog_s[1], fog_s[2]), lights, lr,
-                                                 light_ids, ray_lights, VOL_FEATURES);
+    if (ray_lights > 0) { /* lanes without a medium in their segment scatter nothing */
+      const vol_float3x16 l = vol_segment_lights(s0, s1, sigma_t, optical, fogged, ext_before, fog_ext, in_before,
+                                                 fog_in, fog_channels == 3, channels, each, volumes_here, volumes,
+                                                 count, lights, lr, light_ids, ray_lights, VOL_FEATURES);
       i_r += l.x;
       i_g += l.y;
       i_b += l.z;
@@ -444,10 +430,10 @@ kernel void volume_march(global const float* depth, global const float* frame, g
 #else
 #if VOL_FEATURES & VOL_FEATURE_LIGHTS
     if (ray_lights > 0 && VOL_ANY16(adds)) {
-      const float16 sigma_all = adds ? sigma_t : 0.0f;
-      const vol_float3x16 l = vol_lights_segment(s0, s1, &sigma_all, &optical, 1, each, volumes_here, volumes, count,
-                                                 vol_make3_x16(0.0f, 0.0f, 0.0f), lights, lr, light_ids, ray_lights,
-                                                 VOL_FEATURES);
+      const float16 none[3] = {0.0f, 0.0f, 0.0f}; /* no marched fog */
+      const vol_float3x16 l = vol_segment_lights(s0, s1, sigma_t, optical, (int16)0, none, none, none, none, 0, 1,
+                                                 each, volumes_here, volumes, count, lights, lr, light_ids,
+                                                 ray_lights, VOL_FEATURES);
       i_r += l.x;
       i_g += l.y;
       i_b += l.z;
